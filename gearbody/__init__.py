@@ -1,0 +1,22 @@
+"""gearbody: gearbox vibration simulation for diagnostics, on the Exudyn multibody engine.
+
+After W. Bartelmus, *Mathematical modelling and computer simulations as an aid to gearbox
+diagnostics*, Mechanical Systems and Signal Processing 15(5), 2001.
+"""
+
+__version__ = "0.1.0"
+
+from .model import Scenario, ScenarioError, dump_scenario, load_scenario  # noqa: E402
+from .result import Result  # noqa: E402
+
+
+def simulate(scenario, *, progress: bool = False) -> Result:
+    """Simulate a :class:`Scenario` (or a scene name / TOML path) on Exudyn; see :mod:`gearbody.engine`."""
+    from .engine import simulate as _simulate
+
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    return _simulate(scenario, progress=progress)
+
+
+__all__ = ["Result", "Scenario", "ScenarioError", "__version__", "dump_scenario", "load_scenario", "simulate"]

@@ -1,0 +1,37 @@
+"""Engine-free analysis of simulated or measured signals (plain numpy arrays in, dataclasses out)."""
+
+from gearbody.analysis.dynamic_factor import (
+    INSTABILITY_KD,
+    FoldedSignal,
+    SeparationStats,
+    fold_over_mesh_period,
+    mesh_phase,
+    periods_stats,
+    separation_stats,
+    unstable,
+)
+from gearbody.analysis.spectrum import (
+    Peak,
+    Spectrum,
+    amplitude_spectrum,
+    mesh_harmonics,
+    peak_at,
+    peak_near,
+)
+
+__all__ = [
+    "INSTABILITY_KD",
+    "FoldedSignal",
+    "Peak",
+    "SeparationStats",
+    "Spectrum",
+    "amplitude_spectrum",
+    "fold_over_mesh_period",
+    "mesh_harmonics",
+    "mesh_phase",
+    "peak_at",
+    "peak_near",
+    "periods_stats",
+    "separation_stats",
+    "unstable",
+]

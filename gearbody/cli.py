@@ -1,0 +1,146 @@
+"""Command line: ``gearbody list | run | modes | validate``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+EPILOG = """examples:
+  gearbody list
+  gearbody run one-stage --out runs/one-stage
+  gearbody run one-stage --set production.error_mode.e_um=15 --set design.coupling.damping_Nms_per_rad=1000
+  gearbody run my-drive.toml --t-end 1.0 --out runs/mine
+  gearbody modes one-stage
+  gearbody validate one-stage
+"""
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="gearbody", description="Gearbox vibration simulation for diagnostics (Exudyn multibody engine).",
+        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    sub.add_parser("list", help="list the shipped scenes, one per line (name first, then its title)")
+
+    run = sub.add_parser("run", help="simulate a scene or scenario file and write results and plots",
+                         formatter_class=argparse.RawDescriptionHelpFormatter, description=(
+                             "Simulate SCENE and write DIR/result.npz (named arrays: time, mesh_force_N, kd, "
+                             "angles, speeds, accelerations, ...), DIR/scenario.toml (fully resolved, re-runnable "
+                             "with 'gearbody run DIR/scenario.toml'), DIR/summary.json and PNG plots (K_d over "
+                             "time, K_d folded over the mesh period, spectrum of the pinion acceleration)."))
+    run.add_argument("scene", metavar="SCENE", help="scene name (see 'gearbody list') or path to a .toml scenario")
+    run.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                     help="override a scenario value by its dotted key, e.g. production.error_mode.e_um=15 "
+                          "(repeatable; values are TOML: numbers, true/false, [arrays], \"strings\")")
+    run.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time (sets operation.t_end_s)")
+    run.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: runs/SCENE)")
+    run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run.add_argument("--quiet", action="store_true", help="no progress display and no summary on screen")
+
+    modes = sub.add_parser("modes", help="natural frequencies (Hz) at mean mesh stiffness, and resonance speeds")
+    modes.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
+    modes.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                       help="override a scenario value (as for run)")
+    modes.add_argument("--harmonics", type=int, default=3, help="mesh harmonics to list resonance speeds for")
+
+    val = sub.add_parser("validate", help="compare gearbody with the independent ODE reference (exit 1 above tolerance)")
+    val.add_argument("scenes", metavar="SCENE", nargs="*", help="scenes to validate (default: all)")
+    val.add_argument("--short", action="store_true", help="short runs (as in the test suite)")
+    val.add_argument("--tolerance", type=float, default=0.5, help="max |dF|/F_rated in %% (default 0.5)")
+    return p
+
+
+def _load(scene: str, overrides: list[str]):
+    from .model import load_scenario
+
+    return load_scenario(scene, overrides)
+
+
+def cmd_list(_args) -> int:
+    from .model import load_scenario
+    from .scenes import list_scenes
+
+    for name in list_scenes():
+        print(f"{name}\t{load_scenario(name).meta.title}")
+    return 0
+
+
+def cmd_run(args) -> int:
+    from .engine import simulate
+    from .model import dump_scenario
+    from .summary import summarize, write_plots
+
+    overrides = list(args.overrides)
+    if args.t_end is not None:
+        overrides.append(f"operation.t_end_s={args.t_end!r}")
+    scenario = _load(args.scene, overrides)
+    out = args.out or Path("runs") / (Path(args.scene).stem if args.scene.endswith(".toml") else args.scene)
+    out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    result = simulate(scenario, progress=not args.quiet)
+    result.save_npz(out / "result.npz")
+    dump_scenario(scenario, out / "scenario.toml")
+    summary = summarize(result)
+    summary["wall_time_s"] = time.perf_counter() - t0
+    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    plots = [] if args.no_plots else write_plots(result, out)
+    if not args.quiet:
+        print(f"{scenario.meta.title}")
+        for key in ("kd_max", "kd_max_final", "kd_mean_final", "separation_fraction", "mesh_frequency_hz",
+                    "mean_speed_rad_s", "simulated_time_s", "wall_time_s"):
+            v = summary[key]
+            print(f"  {key:22s} {v:.4g}" if isinstance(v, float) else f"  {key:22s} {v}")
+        print(f"wrote {out}/result.npz, scenario.toml, summary.json" + (f", {len(plots)} plots" if plots else ""))
+    return 0
+
+
+def cmd_modes(args) -> int:
+    from .engine import scene_modes
+    from .engine.modes import resonance_speeds_rad_s
+
+    scenario = _load(args.scene, args.overrides)
+    modes = scene_modes(scenario)
+    z1 = scenario.design.pinion.teeth
+    k = modes.mean_mesh_stiffness_N_per_m
+    print(f"{scenario.meta.title}")
+    print(f"linearised at mean mesh stiffness {k:.4g} N/m; DOFs: {', '.join(modes.dof_names)}")
+    speeds = resonance_speeds_rad_s(modes, z1, args.harmonics)
+    head = "".join(f"  w({h}f_z) rad/s  " for h in range(1, args.harmonics + 1))
+    print(f"{'mode':>4} {'f_n Hz':>12}  {'dominant DOF':<12}{head}")
+    for m, f in enumerate(modes.frequencies_hz):
+        cols = "".join(f"{'-' if math.isnan(s) else f'{s:.2f}':>18}" for s in speeds[:, m])
+        print(f"{m + 1:>4} {f:12.3f}  {modes.dominant_dof(m):<12}{cols}")
+    print(f"(w(k f_z) = pinion speed at which the k-th mesh harmonic z1 w k / 2 pi meets f_n; z1 = {z1})")
+    return 0
+
+
+def cmd_validate(args) -> int:
+    from .validation.compare import run_validation
+
+    ok = run_validation(args.scenes or None, short=args.short, tolerance_percent=args.tolerance)
+    return 0 if ok else 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    from .engine.simulate import SimulationError
+    from .model import ScenarioError
+
+    args = _parser().parse_args(argv)
+    handlers = {"list": cmd_list, "run": cmd_run, "modes": cmd_modes, "validate": cmd_validate}
+    try:
+        return handlers[args.command](args)
+    except ScenarioError as exc:
+        print(f"gearbody: invalid scenario: {exc}", file=sys.stderr)
+        return 2
+    except SimulationError as exc:
+        print(f"gearbody: simulation failed: {exc}", file=sys.stderr)
+        return 3
+
+
+if __name__ == "__main__":
+    sys.exit(main())

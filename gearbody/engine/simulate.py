@@ -1,0 +1,253 @@
+"""Run a scenario on Exudyn and return a :class:`~gearbody.result.Result` on a fixed output grid.
+
+The explicit adaptive solver records every step (sensors with write period 0). Coordinates are then
+resampled onto ``t_k = k / output_rate_hz`` with cubic Hermite interpolation (positions from positions
+and velocities, velocities from velocities and accelerations), and the mesh force is evaluated on the
+resampled states by the same compiled law the solver used.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import exudyn as exu
+import exudyn.solver
+import numpy as np
+from scipy.interpolate import CubicHermiteSpline
+
+from .. import __version__
+from ..model import Scenario, scenario_to_dict
+from ..physics import load_torque_at, motor_torque_at, synchronous_angle_at
+from ..physics.mesh import mesh_contact_series, mesh_parameters_from_scenario, mesh_phase_series
+from ..physics.motor import pack_drive_parameters
+from ..result import Result
+from .build import BuiltSystem, build_muller, build_torsional
+from .layout import initial_state, mesh_frequency_hz, torsional_layout
+
+SOLVER_TYPES = {name: getattr(exu.DynamicSolverType, name) for name in ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")}
+MIN_STEP_S = 1e-10
+MAX_MIN_STEP_RUN = 1000
+
+
+class SimulationError(RuntimeError):
+    """Numerical failure (non-finite state, divergence, step-size collapse), with the time it happened."""
+
+
+@dataclass
+class _Monitor:
+    """Pre-step hook: progress display after a few seconds of wall time, and divergence detection."""
+
+    mbs: exu.MainSystem
+    watch_node: int
+    t_end: float
+    speed_limit: float
+    progress: bool
+    every: int = 200
+    count: int = 0
+    bar: object = None
+    failure: str = ""
+    last_draw: float = 0.0
+
+    def __post_init__(self):
+        self.t_wall0 = time.monotonic()
+
+    def __call__(self, mbs, t):
+        self.count += 1
+        if self.count % self.every:
+            return True
+        w = float(np.ravel(mbs.GetNodeOutput(self.watch_node, exu.OutputVariableType.Coordinates_t))[0])
+        if not math.isfinite(w) or abs(w) > self.speed_limit:
+            self.failure = (f"state diverged at t = {t:.6g} s (speed of {self.watch_node=} is {w:.3g} rad/s). "
+                            "Hint: check stiffness, inertia and load values, or tighten solver tolerances / "
+                            "lower solver.max_step_s")
+            return False
+        if self.progress:
+            if self.bar is None and time.monotonic() - self.t_wall0 > 2.0:
+                from tqdm import tqdm
+
+                self.bar = tqdm(total=round(self.t_end, 6), unit="s sim", desc="simulating",
+                                bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s sim [{elapsed}<{remaining}]")
+            now = time.monotonic()
+            if self.bar is not None and now - self.last_draw > 0.5:
+                self.last_draw = now
+                self.bar.n = round(t, 6)
+                self.bar.refresh()
+        return True
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.n = self.bar.total
+            self.bar.close()
+
+
+def solver_settings(scenario: Scenario) -> exu.SimulationSettings:
+    s = exu.SimulationSettings()
+    sv, t_end = scenario.solver, scenario.operation.t_end_s
+    ti = s.timeIntegration
+    ti.endTime = t_end
+    ti.numberOfSteps = max(1, math.ceil(t_end / sv.max_step_s))  # max step = endTime / numberOfSteps
+    ti.automaticStepSize = True
+    ti.relativeTolerance = sv.relative_tolerance
+    ti.absoluteTolerance = sv.absolute_tolerance
+    ti.minimumStepSize = MIN_STEP_S
+    ti.initialStepSize = min(sv.max_step_s, 1e-6)
+    ti.verboseMode = 0
+    ti.explicit.computeEndOfStepAccelerations = True
+    s.solution.file.write = False
+    s.solution.sensors.writePeriod = 0.0  # every step; resampled afterwards
+    s.show.computationTime = False
+    s.show.statistics = False
+    return s
+
+
+def build(scenario: Scenario) -> tuple[BuiltSystem, np.ndarray, np.ndarray]:
+    """Exudyn system of a scenario at its initial state."""
+    try:
+        q0, v0 = initial_state(scenario)
+    except ValueError as exc:
+        raise SimulationError(f"cannot set the initial state: {exc}") from None
+    if scenario.meta.scene == "muller":
+        return build_muller(scenario, q0, v0), q0, v0
+    return build_torsional(torsional_layout(scenario), q0, v0), q0, v0
+
+
+def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
+    """Simulate a scenario; raise :class:`SimulationError` on numerical failure."""
+    wall0 = time.perf_counter()
+    built, _, _ = build(scenario)
+    build_s = time.perf_counter() - wall0
+    mbs = built.mbs
+    watch = built.nodes[0]
+    limit = 100.0 * scenario.design.motor.synchronous_speed_rad_s
+    if scenario.meta.scene == "muller":
+        limit = 1e3  # m/s of deflection rate: anything near this is divergence
+    monitor = _Monitor(mbs, watch, scenario.operation.t_end_s, limit, progress)
+    mbs.SetPreStepUserFunction(monitor)
+    settings = solver_settings(scenario)
+    t_solve0 = time.perf_counter()
+    exu.SuppressWarnings(True)  # min-step notices: gearbody checks the steps itself (_collect)
+    # Python user functions allocate their return lists by design; Exudyn's allocation notice says so.
+    exudyn.solver.solverCheckMemoryAllocationsThreshold = 2**62
+    try:
+        exu.SolveDynamic(mbs, settings, solverType=SOLVER_TYPES[scenario.solver.method], storeSolver=True,
+                         showHints=False)
+    finally:
+        exu.SuppressWarnings(False)
+        monitor.close()
+    solve_s = time.perf_counter() - t_solve0
+    if monitor.failure:
+        raise SimulationError(monitor.failure)
+    result = _collect(scenario, built)
+    it = mbs.sys["dynamicSolver"].it
+    result.meta["solver_statistics"]["rejected_steps"] = int(it.rejectedAutomaticStepSizeSteps)
+    result.meta["solver_statistics"].update({"build_wall_s": build_s, "solve_wall_s": solve_s,
+                                             "wall_time_s": time.perf_counter() - wall0})
+    return result
+
+
+def _longest_run_start(flags: np.ndarray, length: int) -> int | None:
+    """Index where the first run of ``length`` consecutive True values starts, or None."""
+    if flags.size < length:
+        return None
+    counts = np.convolve(flags.astype(np.int32), np.ones(length, np.int32), mode="valid")
+    hit = np.flatnonzero(counts == length)
+    return int(hit[0]) if hit.size else None
+
+
+def _stored(mbs, sensor_ids: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    data = [mbs.GetSensorStoredData(s) for s in sensor_ids]
+    return data[0][:, 0], np.stack([d[:, 1] for d in data])
+
+
+def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
+    mbs = built.mbs
+    t_steps, q = _stored(mbs, built.sensors["q"])
+    _, v = _stored(mbs, built.sensors["v"])
+    _, a = _stored(mbs, built.sensors["a"])
+    t_end = scenario.operation.t_end_s
+    bad = ~(np.isfinite(q).all(axis=0) & np.isfinite(v).all(axis=0))
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise SimulationError(f"non-finite state at t = {t_steps[k]:.6g} s. Hint: lower solver.max_step_s or "
+                              "check for zero or negative stiffness/inertia values")
+    if t_steps[-1] < t_end * (1 - 1e-9):
+        raise SimulationError(f"the solver stopped at t = {t_steps[-1]:.6g} s before t_end = {t_end} s")
+    steps = np.diff(t_steps)
+    n_steps = int(np.count_nonzero(steps > 0))
+    # Crossing a jump of k_z takes a few minimum-size steps; a long run of them means the step size
+    # collapsed (the solver then creeps on with errors above its tolerance).
+    at_min = steps <= MIN_STEP_S * 1.0001
+    run_start = _longest_run_start(at_min, MAX_MIN_STEP_RUN)
+    if run_start is not None:
+        raise SimulationError(
+            f"step size collapsed to {MIN_STEP_S:g} s for {MAX_MIN_STEP_RUN}+ steps from t = {t_steps[run_start]:.6g} s. "
+            "Hint: loosen solver.relative_tolerance / absolute_tolerance, or check for extreme stiffness ratios")
+    # The first acceleration row is not computed by the explicit solver; drop duplicate time rows.
+    keep = np.concatenate([[True], steps > 0])
+    t_steps, q, v, a = t_steps[keep], q[:, keep], v[:, keep], a[:, keep]
+    a[:, 0] = a[:, 1] if a.shape[1] > 1 else 0.0
+    rate = scenario.solver.output_rate_hz
+    t = np.arange(math.floor(t_end * rate + 1e-9) + 1) / rate
+    qs = CubicHermiteSpline(t_steps, q, v, axis=1)(t)
+    vs = CubicHermiteSpline(t_steps, v, a, axis=1)(t)
+    acc = np.stack([np.interp(t, t_steps, row) for row in a])
+    signals: dict[str, np.ndarray] = {}
+    if scenario.meta.scene == "muller":
+        signals.update(_muller_signals(scenario, t, qs[0], vs[0], acc[0]))
+    else:
+        signals.update(_torsional_signals(scenario, built.dof_names, t, qs, vs, acc))
+    stats = {"steps": n_steps, "method": scenario.solver.method,
+             "min_step_s": float(steps[steps > 0].min()) if n_steps else 0.0,
+             "max_step_s": float(steps.max()) if n_steps else 0.0,
+             "min_step_hits": int(np.count_nonzero(at_min))}
+    meta = {
+        "scene": scenario.meta.scene, "title": scenario.meta.title, "seed": scenario.meta.seed,
+        "scenario": scenario_to_dict(scenario), "gearbody_version": __version__,
+        "exudyn_version": exu.__version__, "output_rate_hz": rate, "dof_names": built.dof_names,
+        "rated_mesh_force_N": scenario.rated_mesh_force_N, "pinion_teeth": scenario.design.pinion.teeth,
+        "wheel_teeth": scenario.design.wheel.teeth, "sources": list(scenario.meta.sources),
+        "solver_statistics": stats,
+    }
+    return Result(time_s=t, signals=signals, meta=meta)
+
+
+def _mesh_signals(scenario: Scenario, pinion_angle, delta, delta_rate, P) -> dict[str, np.ndarray]:
+    F, T = mesh_contact_series(np.ascontiguousarray(pinion_angle), np.ascontiguousarray(delta),
+                               np.ascontiguousarray(delta_rate), P)
+    p, i, j = mesh_phase_series(np.ascontiguousarray(pinion_angle), P)
+    return {"mesh_force_N": F, "kd": F / scenario.rated_mesh_force_N, "friction_force_N": T,
+            "mesh_deflection_m": delta, "mesh_phase": p, "pinion_tooth": i, "wheel_tooth": j}
+
+
+def _torsional_signals(scenario, names, t, q, v, a) -> dict[str, np.ndarray]:
+    out = {}
+    for k, name in enumerate(names):
+        out[f"{name}_angle_rad"] = q[k]
+        out[f"{name}_speed_rad_s"] = v[k]
+        out[f"{name}_accel_rad_s2"] = a[k]
+    r1, r2 = scenario.design.pinion.base_radius_m, scenario.design.wheel.base_radius_m
+    ip, iw = names.index("pinion"), names.index("wheel")
+    P = mesh_parameters_from_scenario(scenario)
+    out.update(_mesh_signals(scenario, q[ip], r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw], P))
+    D = pack_drive_parameters(scenario)
+    out["motor_torque_Nm"] = np.array([motor_torque_at(tk, w, D) for tk, w in zip(t, v[0])])
+    out["load_torque_Nm"] = np.array([load_torque_at(tk, D) for tk in t])
+    out["mesh_frequency_hz"] = scenario.design.pinion.teeth * v[ip] / (2 * math.pi)
+    return out
+
+
+def _muller_signals(scenario, t, x, xd, xdd) -> dict[str, np.ndarray]:
+    D = pack_drive_parameters(scenario)
+    theta = np.array([synchronous_angle_at(tk, D) for tk in t])
+    out = {"deflection_m": x, "deflection_rate_m_s": xd, "deflection_accel_m_s2": xdd,
+           "pinion_angle_rad": theta}
+    P = mesh_parameters_from_scenario(scenario, friction=False)
+    out.update(_mesh_signals(scenario, theta, x, xd, P))
+    out["load_torque_Nm"] = np.array([load_torque_at(tk, D) for tk in t])
+    out["mesh_frequency_hz"] = np.gradient(theta, t) * scenario.design.pinion.teeth / (2 * math.pi)
+    return out
+
+
+__all__ = ["SimulationError", "build", "simulate", "solver_settings", "mesh_frequency_hz"]

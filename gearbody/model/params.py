@@ -1,0 +1,168 @@
+"""Typed, range-checked parameters and the conversion of nested dicts (TOML) into dataclass trees.
+
+A model dataclass declares each field with :func:`param`, giving its unit-carrying name, range and
+meaning. :func:`from_dict` turns a nested dict into that dataclass tree and refuses bad input with a
+:class:`ScenarioError` that names the source, the key, the value and the allowed range, before
+anything runs. Unknown keys get the nearest valid key as a suggestion.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+import types
+import typing
+from typing import Any, get_args, get_origin, get_type_hints
+
+
+class ScenarioError(ValueError):
+    """Invalid scenario input; the message names file, key, value and allowed range."""
+
+
+def param(
+    default: Any = dataclasses.MISSING,
+    *,
+    doc: str = "",
+    gt: float | None = None,
+    ge: float | None = None,
+    lt: float | None = None,
+    le: float | None = None,
+    choices: tuple[Any, ...] | None = None,
+    default_factory: Any = dataclasses.MISSING,
+) -> Any:
+    """A dataclass field with a documented meaning, unit (in its name) and allowed range."""
+    meta = {"doc": doc, "gt": gt, "ge": ge, "lt": lt, "le": le, "choices": choices}
+    if default_factory is not dataclasses.MISSING:
+        return dataclasses.field(default_factory=default_factory, metadata=meta)
+    return dataclasses.field(default=default, metadata=meta)
+
+
+def describe_range(meta: typing.Mapping[str, Any]) -> str:
+    """Human text for a field's allowed range, e.g. '> 0', '[0, 1]'."""
+    if meta.get("choices"):
+        return "one of " + ", ".join(repr(c) for c in meta["choices"])
+    lo = f"> {meta['gt']:g}" if meta.get("gt") is not None else (
+        f">= {meta['ge']:g}" if meta.get("ge") is not None else "")
+    hi = f"< {meta['lt']:g}" if meta.get("lt") is not None else (
+        f"<= {meta['le']:g}" if meta.get("le") is not None else "")
+    if lo and hi:
+        return f"{lo} and {hi}"
+    return lo or hi or "any value"
+
+
+def _in_range(value: float, meta: typing.Mapping[str, Any]) -> bool:
+    if meta.get("gt") is not None and not value > meta["gt"]:
+        return False
+    if meta.get("ge") is not None and not value >= meta["ge"]:
+        return False
+    if meta.get("lt") is not None and not value < meta["lt"]:
+        return False
+    return not (meta.get("le") is not None and not value <= meta["le"])
+
+
+class _Ctx:
+    """Where a value came from: file name and dotted key path, for error messages."""
+
+    def __init__(self, source: str, path: str = ""):
+        self.source, self.path = source, path
+
+    def child(self, key: str) -> _Ctx:
+        return _Ctx(self.source, f"{self.path}.{key}" if self.path else key)
+
+    def fail(self, value: Any, message: str) -> typing.NoReturn:
+        raise ScenarioError(f"{self.source}: {self.path} = {value!r}: {message}")
+
+
+def _type_name(tp: Any) -> str:
+    return getattr(tp, "__name__", str(tp))
+
+
+def _convert(value: Any, tp: Any, ctx: _Ctx, meta: typing.Mapping[str, Any]) -> Any:
+    origin = get_origin(tp)
+    if origin in (typing.Union, types.UnionType):
+        args = [a for a in get_args(tp) if a is not type(None)]
+        if value is None:
+            return None
+        return _convert(value, args[0], ctx, meta)
+    if dataclasses.is_dataclass(tp):
+        if not isinstance(value, dict):
+            ctx.fail(value, f"must be a table of {_type_name(tp)} keys")
+        return _from_dict(tp, value, ctx)
+    if origin in (tuple, list):
+        if not isinstance(value, (list, tuple)):
+            ctx.fail(value, "must be a list")
+        (item_tp, *_rest) = get_args(tp)
+        return tuple(_convert(v, item_tp, ctx.child(f"[{i}]"), {}) for i, v in enumerate(value))
+    if tp is bool:
+        if not isinstance(value, bool):
+            ctx.fail(value, "must be true or false")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            ctx.fail(value, f"must be a whole number ({describe_range(meta)})")
+    elif tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            ctx.fail(value, f"must be a number ({describe_range(meta)})")
+        value = float(value)
+        if not math.isfinite(value):
+            ctx.fail(value, "must be finite")
+    elif tp is str:
+        if not isinstance(value, str):
+            ctx.fail(value, "must be a string")
+    if meta.get("choices") and value not in meta["choices"]:
+        near = difflib.get_close_matches(str(value), [str(c) for c in meta["choices"]], n=1)
+        hint = f"; did you mean {near[0]!r}?" if near else ""
+        ctx.fail(value, f"must be {describe_range(meta)}{hint}")
+    if tp in (int, float) and not _in_range(value, meta):
+        ctx.fail(value, f"must be {describe_range(meta)}")
+    return value
+
+
+def _from_dict(cls: type, data: typing.Mapping[str, Any], ctx: _Ctx) -> Any:
+    hints = get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    for key in data:
+        if key not in fields:
+            near = difflib.get_close_matches(key, list(fields), n=1, cutoff=0.5)
+            hint = (f"; did you mean {ctx.child(near[0]).path!r}?" if near
+                    else f"; valid keys here: {', '.join(fields)}")
+            raise ScenarioError(f"{ctx.source}: unknown key {ctx.child(key).path!r}{hint}")
+    kwargs = {}
+    for name, f in fields.items():
+        sub = ctx.child(name)
+        if name not in data:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                doc = f.metadata.get("doc", "")
+                raise ScenarioError(
+                    f"{ctx.source}: missing required key {sub.path!r}"
+                    + (f" ({doc}; {describe_range(f.metadata)})" if doc else ""))
+            continue
+        kwargs[name] = _convert(data[name], hints[name], sub, f.metadata)
+    try:
+        obj = cls(**kwargs)
+    except ScenarioError as exc:
+        where = f"[{ctx.path}] " if ctx.path else ""
+        raise ScenarioError(f"{ctx.source}: {where}{exc}") from None
+    return obj
+
+
+def from_dict(cls: type, data: typing.Mapping[str, Any], source: str = "<scenario>") -> Any:
+    """Build dataclass ``cls`` from a nested dict, checking keys, types and ranges."""
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{source}: the scenario must be a table of sections, got {type(data).__name__}")
+    return _from_dict(cls, data, _Ctx(source))
+
+
+def to_dict(obj: Any) -> Any:
+    """Dataclass tree -> nested dict of TOML-writable values (None fields are left out)."""
+    if dataclasses.is_dataclass(obj):
+        out = {}
+        for f in dataclasses.fields(obj):
+            v = getattr(obj, f.name)
+            if v is not None:
+                out[f.name] = to_dict(v)
+        return out
+    if isinstance(obj, (list, tuple)):
+        return [to_dict(v) for v in obj]
+    return obj

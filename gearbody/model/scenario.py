@@ -1,0 +1,204 @@
+"""The scenario: a validated, immutable description of a drive, grouped as the paper's DPTOCC factors.
+
+Design (components, mesh), production technology (error mode), operation (speed and load profiles),
+change of condition (damaged teeth, friction). See ``docs/scenario.md`` for every key and equation.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .params import ScenarioError, param
+
+SCENES = ("muller", "two-wheel", "one-stage")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Meta:
+    scene: str = param(doc="system topology", choices=SCENES)
+    title: str = param("", doc="free text")
+    sources: tuple[str, ...] = param((), doc="where the parameter values come from")
+    seed: int = param(1, ge=0, doc="seed of the random per-tooth error factors l_i")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Motor:
+    """Induction motor with the Kloss characteristic M_s = 2 M_b s s_b / (s^2 + s_b^2)."""
+
+    inertia_kg_m2: float = param(gt=0, doc="rotor inertia I_s")
+    synchronous_speed_rad_s: float = param(gt=0, doc="rated synchronous speed w_s")
+    breakdown_torque_Nm: float = param(gt=0, doc="breakdown (pull-out) torque M_b")
+    breakdown_slip: float = param(gt=0, le=1, doc="breakdown slip s_b")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Shaft:
+    """Torsional spring-damper between two inertias (coupling or shaft)."""
+
+    stiffness_Nm_per_rad: float = param(gt=0, doc="torsional stiffness k")
+    damping_Nms_per_rad: float = param(0.0, ge=0, doc="torsional damping C")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Gear:
+    teeth: int = param(ge=6, doc="number of teeth z")
+    base_radius_m: float = param(gt=0, doc="base radius r_b")
+    inertia_kg_m2: float = param(gt=0, doc="polar moment of inertia")
+    mass_kg: float = param(gt=0, doc="mass (lateral models)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Machine:
+    inertia_kg_m2: float = param(gt=0, doc="driven machine inertia I_m")
+    rated_torque_Nm: float = param(gt=0, doc="load torque at rated load on the machine shaft")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Mesh:
+    """Gear mesh: stiffness profile k_z(p), damping C_z, backlash l_u, friction geometry."""
+
+    stiffness_profile: str = param("contact-ratio", choices=("contact-ratio", "table"),
+                                   doc="how k_z(p) is given")
+    stiffness_single_N_per_m: float = param(1.2e9, gt=0, doc="k_z with one tooth pair in contact")
+    stiffness_double_N_per_m: float = param(1.3e9, gt=0, doc="k_z with two tooth pairs in contact")
+    contact_ratio: float = param(1.6, ge=1, lt=2, doc="transverse contact ratio eps_alpha")
+    table_phase: tuple[float, ...] = param((), doc="mesh phases in [0, 1) of a k_z table")
+    table_stiffness_N_per_m: tuple[float, ...] = param((), doc="k_z at table_phase")
+    damping_Ns_per_m: float = param(0.0, ge=0, doc="mesh damping C_z")
+    backlash_um: float = param(0.0, ge=0, doc="l_u: half-width of the dead zone of eq. (4)")
+    pressure_angle_deg: float = param(20.0, gt=0, lt=45, doc="operating pressure angle")
+    pitch_point_phase: float = param(0.5, ge=0, le=1, doc="mesh phase where friction reverses")
+
+    def __post_init__(self) -> None:
+        if self.stiffness_profile == "table":
+            ph, k = self.table_phase, self.table_stiffness_N_per_m
+            if len(ph) < 2 or len(ph) != len(k):
+                raise ScenarioError(
+                    f"table_phase ({len(ph)} values) and table_stiffness_N_per_m ({len(k)} values) "
+                    "must have the same length >= 2")
+            if any(not 0 <= p < 1 for p in ph) or any(b <= a for a, b in zip(ph, ph[1:])):
+                raise ScenarioError(f"table_phase = {list(ph)}: must increase strictly within [0, 1)")
+            if any(v < 0 for v in k):
+                raise ScenarioError(f"table_stiffness_N_per_m = {list(k)}: values must be >= 0")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Design:
+    motor: Motor
+    pinion: Gear
+    wheel: Gear
+    machine: Machine
+    mesh: Mesh = param(default_factory=Mesh)
+    coupling: Shaft | None = param(None, doc="motor-pinion coupling (one-stage)")
+    output_shaft: Shaft | None = param(None, doc="wheel-machine shaft (one-stage)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class ErrorMode:
+    """Tooth error mode E(a, e, r) of the paper (Fig. 4, eq. 6)."""
+
+    a: float = param(0.5, ge=0, le=1, doc="position of the maximum error in the mesh period")
+    e_um: float = param(0.0, doc="maximum error e (negative allowed)")
+    r: float = param(0.0, ge=0, le=1, doc="scope of the random per-tooth variation")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Production:
+    error_mode: ErrorMode = param(default_factory=ErrorMode)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Profile:
+    """Piecewise-linear fraction over time, held constant outside the given points."""
+
+    time_s: tuple[float, ...] = param(doc="times, increasing")
+    fraction: tuple[float, ...] = param(doc="fraction at those times, >= 0")
+
+    def __post_init__(self) -> None:
+        t, f = self.time_s, self.fraction
+        if len(t) < 1 or len(t) != len(f):
+            raise ScenarioError(f"time_s ({len(t)} values) and fraction ({len(f)} values) must have "
+                                "the same length >= 1")
+        if any(x < 0 for x in t) or any(b <= a for a, b in zip(t, t[1:])):
+            raise ScenarioError(f"time_s = {list(t)}: must be >= 0 and strictly increasing")
+        if any(not (x >= 0 and math.isfinite(x)) for x in f):
+            raise ScenarioError(f"fraction = {list(f)}: values must be finite and >= 0")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Operation:
+    t_end_s: float = param(gt=0, doc="simulated time")
+    initial_state: str = param("rest", choices=("rest", "steady"), doc="start from rest or steady running")
+    speed_profile: Profile = param(default_factory=lambda: Profile(time_s=(0.0,), fraction=(1.0,)),
+                                   doc="fraction of the synchronous speed over time")
+    load_profile: Profile = param(default_factory=lambda: Profile(time_s=(0.0,), fraction=(1.0,)),
+                                  doc="fraction of the rated load torque over time")
+
+
+@dataclass(frozen=True, kw_only=True)
+class DamagedTooth:
+    gear: str = param(choices=("pinion", "wheel"))
+    tooth: int = param(ge=0, doc="tooth index, 0-based")
+    stiffness_factor: float = param(ge=0, le=1, doc="factor on k_z while this tooth meshes")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Condition:
+    friction_coefficient: float = param(0.0, ge=0, lt=1, doc="inter-tooth friction mu")
+    damaged_teeth: tuple[DamagedTooth, ...] = param((), doc="per-tooth stiffness factors")
+
+
+SOLVER_METHODS = ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Solver:
+    method: str = param("DOPRI5", choices=SOLVER_METHODS, doc="Exudyn explicit integrator")
+    relative_tolerance: float = param(1e-8, gt=0, lt=1, doc="adaptive step relative tolerance")
+    absolute_tolerance: float = param(1e-9, gt=0, doc="adaptive step absolute tolerance")
+    max_step_s: float = param(1e-4, gt=0, doc="largest step")
+    output_rate_hz: float = param(20000.0, gt=0, doc="results are sampled at k / output_rate_hz")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Scenario:
+    meta: Meta
+    design: Design
+    production: Production = param(default_factory=Production)
+    operation: Operation
+    condition: Condition = param(default_factory=Condition)
+    solver: Solver = param(default_factory=Solver)
+
+    def __post_init__(self) -> None:
+        d = self.design
+        if self.meta.scene == "one-stage":
+            for name in ("coupling", "output_shaft"):
+                if getattr(d, name) is None:
+                    raise ScenarioError(f"design.{name} is required for scene 'one-stage'")
+        pb1 = 2 * math.pi * d.pinion.base_radius_m / d.pinion.teeth
+        pb2 = 2 * math.pi * d.wheel.base_radius_m / d.wheel.teeth
+        if abs(pb2 / pb1 - 1) > 0.005:
+            raise ScenarioError(
+                f"design.wheel.base_radius_m = {d.wheel.base_radius_m}: base pitch 2 pi r_b / z = {pb2 * 1e3:.4f} mm "
+                f"differs from the pinion's {pb1 * 1e3:.4f} mm by more than 0.5 %; meshing gears need "
+                f"equal base pitches (r_b2 = r_b1 z2 / z1 = {d.pinion.base_radius_m * d.wheel.teeth / d.pinion.teeth:.6g} m)")
+        for t in self.condition.damaged_teeth:
+            z = getattr(d, t.gear).teeth
+            if t.tooth >= z:
+                raise ScenarioError(f"condition.damaged_teeth: tooth = {t.tooth} on the {t.gear}: "
+                                    f"must be < its {z} teeth")
+        if self.solver.output_rate_hz * self.operation.t_end_s < 2:
+            raise ScenarioError(f"solver.output_rate_hz = {self.solver.output_rate_hz}: gives fewer than 2 "
+                                f"samples over t_end_s = {self.operation.t_end_s}")
+
+    # -- derived quantities used everywhere ------------------------------------------------
+    @property
+    def gear_ratio(self) -> float:
+        """Wheel to pinion ratio z2/z1 (= r2/r1 for a standard pair)."""
+        return self.design.wheel.teeth / self.design.pinion.teeth
+
+    @property
+    def rated_mesh_force_N(self) -> float:
+        """F_rated = rated machine torque / wheel base radius."""
+        return self.design.machine.rated_torque_Nm / self.design.wheel.base_radius_m

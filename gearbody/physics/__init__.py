@@ -1,0 +1,34 @@
+"""Engine-free physics: mesh force law, error modes, motor characteristic, operating profiles."""
+
+from .errors import tooth_error_depths_m, tooth_random_factors
+from .mesh import (
+    error_shape,
+    mean_stiffness_N_per_m,
+    mesh_contact,
+    mesh_contact_series,
+    mesh_parameters_from_scenario,
+    mesh_phase_series,
+    pack_mesh_parameters,
+    stiffness_at_phase,
+    torsional_mesh_forces,
+)
+from .motor import (
+    kloss_torque_Nm,
+    load_fraction_at,
+    load_torque_at,
+    motor_torque_at,
+    pack_drive_parameters,
+    steady_slip,
+    synchronous_angle_at,
+    synchronous_speed_at,
+    viscous_equivalent_Nms,
+)
+from .profiles import profile_arrays, profile_integral, profile_value
+
+__all__ = [
+    "error_shape", "kloss_torque_Nm", "load_fraction_at", "load_torque_at", "motor_torque_at",
+    "pack_drive_parameters", "synchronous_angle_at", "synchronous_speed_at", "mean_stiffness_N_per_m", "mesh_contact", "mesh_contact_series",
+    "mesh_parameters_from_scenario", "mesh_phase_series", "pack_mesh_parameters", "profile_arrays",
+    "profile_integral", "profile_value", "steady_slip", "stiffness_at_phase", "tooth_error_depths_m",
+    "tooth_random_factors", "torsional_mesh_forces", "viscous_equivalent_Nms",
+]

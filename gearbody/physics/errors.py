@@ -1,0 +1,19 @@
+"""Production-technology factor: tooth error mode E(a, e, r) with random per-tooth depths, eq. (6)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def tooth_random_factors(teeth: int, seed: int) -> np.ndarray:
+    """l_i in [0, 1), one per pinion tooth: ``numpy.random.default_rng(seed).random(teeth)``.
+
+    This exact draw is part of the scenario format (docs/scenario.md): the same seed gives the same
+    teeth in every run, on every machine.
+    """
+    return np.random.default_rng(seed).random(teeth)
+
+
+def tooth_error_depths_m(e_um: float, r: float, teeth: int, seed: int) -> np.ndarray:
+    """Per-tooth maximum error e_i = [1 - r (1 - l_i)] e of eq. (6), in metres."""
+    return (1.0 - r * (1.0 - tooth_random_factors(teeth, seed))) * e_um * 1e-6

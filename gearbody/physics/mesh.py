@@ -1,0 +1,200 @@
+"""Gear mesh force law, eqs. (4)-(6) of the paper plus inter-tooth friction. Engine-free.
+
+One scalar law, :func:`mesh_contact`, compiled with numba; the solver calls it through
+:func:`torsional_mesh_forces` and post-processing through :func:`mesh_contact_series`, so the forces
+reported are exactly the ones integrated. All parameters travel in one float64 array built by
+:func:`pack_mesh_parameters` (layout in the ``I_*`` constants) so that a call costs few conversions.
+
+Conventions (docs/scenario.md): mesh phase ``p = frac(phi_p z1 / 2 pi)`` from the computed pinion angle;
+pinion tooth ``i = n mod z1`` and wheel tooth ``j = n mod z2`` with ``n = floor(phi_p z1 / 2 pi)``;
+``d = delta + E(p)``, ``F_el = k (max(d - l_u, min(d + l_u, 0)))``; damping only in contact;
+friction ``T = mu F s(p)`` reversing at the pitch point, arms ``rho_1, rho_2`` along the line of action.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .errors import tooth_error_depths_m
+
+# Layout of the packed parameter array.
+I_R1, I_R2, I_Z1, I_Z2 = 0, 1, 2, 3
+I_KIND, I_KSINGLE, I_KDOUBLE, I_HALF_DOUBLE = 4, 5, 6, 7
+I_CZ, I_LU, I_MU, I_PITCH = 8, 9, 10, 11
+I_ARM1, I_ARM2, I_PB, I_A = 12, 13, 14, 15
+I_NTAB = 16
+I_HEADER = 20  # e_i (z1), pinion factors (z1), wheel factors (z2), table phases (n), table k (n)
+
+PROFILE_CONTACT_RATIO, PROFILE_TABLE = 0.0, 1.0
+
+
+def pack_mesh_parameters(
+    *,
+    r1_m: float,
+    r2_m: float,
+    z1: int,
+    z2: int,
+    stiffness_single_N_per_m: float,
+    stiffness_double_N_per_m: float,
+    contact_ratio: float,
+    damping_Ns_per_m: float,
+    backlash_m: float,
+    friction_coefficient: float,
+    pitch_point_phase: float,
+    pressure_angle_rad: float,
+    error_a: float,
+    error_depths_m: np.ndarray,
+    pinion_factors: np.ndarray | None = None,
+    wheel_factors: np.ndarray | None = None,
+    table_phase: np.ndarray | None = None,
+    table_stiffness_N_per_m: np.ndarray | None = None,
+) -> np.ndarray:
+    """Pack everything the mesh law needs into one float64 array (see module docstring)."""
+    f = np.ones(z1) if pinion_factors is None else np.asarray(pinion_factors, float)
+    g = np.ones(z2) if wheel_factors is None else np.asarray(wheel_factors, float)
+    tp = np.zeros(0) if table_phase is None else np.asarray(table_phase, float)
+    tk = np.zeros(0) if table_stiffness_N_per_m is None else np.asarray(table_stiffness_N_per_m, float)
+    e = np.asarray(error_depths_m, float)
+    if e.shape != (z1,) or f.shape != (z1,) or g.shape != (z2,) or tp.shape != tk.shape:
+        raise ValueError("per-tooth arrays must have z1 (errors, pinion factors) or z2 (wheel factors) values")
+    head = np.zeros(I_HEADER)
+    head[I_R1], head[I_R2], head[I_Z1], head[I_Z2] = r1_m, r2_m, z1, z2
+    head[I_KIND] = PROFILE_TABLE if tp.size else PROFILE_CONTACT_RATIO
+    head[I_KSINGLE], head[I_KDOUBLE] = stiffness_single_N_per_m, stiffness_double_N_per_m
+    head[I_HALF_DOUBLE] = 0.5 * (contact_ratio - 1.0)
+    head[I_CZ], head[I_LU], head[I_MU], head[I_PITCH] = (
+        damping_Ns_per_m, backlash_m, friction_coefficient, pitch_point_phase)
+    head[I_ARM1] = r1_m * math.tan(pressure_angle_rad)
+    head[I_ARM2] = r2_m * math.tan(pressure_angle_rad)
+    head[I_PB] = 2.0 * math.pi * r1_m / z1
+    head[I_A] = error_a
+    head[I_NTAB] = tp.size
+    return np.concatenate([head, e, f, g, tp, tk])
+
+
+def mesh_parameters_from_scenario(scenario, *, friction: bool = True) -> np.ndarray:
+    """Packed mesh parameters of a :class:`~gearbody.model.Scenario` (the engine's only entry)."""
+    d, mesh, em = scenario.design, scenario.design.mesh, scenario.production.error_mode
+    z1, z2 = d.pinion.teeth, d.wheel.teeth
+    f, g = np.ones(z1), np.ones(z2)
+    for tooth in scenario.condition.damaged_teeth:
+        (f if tooth.gear == "pinion" else g)[tooth.tooth] *= tooth.stiffness_factor
+    table = mesh.stiffness_profile == "table"
+    return pack_mesh_parameters(
+        r1_m=d.pinion.base_radius_m, r2_m=d.wheel.base_radius_m, z1=z1, z2=z2,
+        stiffness_single_N_per_m=mesh.stiffness_single_N_per_m,
+        stiffness_double_N_per_m=mesh.stiffness_double_N_per_m,
+        contact_ratio=mesh.contact_ratio, damping_Ns_per_m=mesh.damping_Ns_per_m,
+        backlash_m=mesh.backlash_um * 1e-6,
+        friction_coefficient=scenario.condition.friction_coefficient if friction else 0.0,
+        pitch_point_phase=mesh.pitch_point_phase,
+        pressure_angle_rad=math.radians(mesh.pressure_angle_deg),
+        error_a=em.a, error_depths_m=tooth_error_depths_m(em.e_um, em.r, z1, scenario.meta.seed),
+        pinion_factors=f, wheel_factors=g,
+        table_phase=np.array(mesh.table_phase) if table else None,
+        table_stiffness_N_per_m=np.array(mesh.table_stiffness_N_per_m) if table else None,
+    )
+
+
+@njit(cache=True)
+def stiffness_at_phase(p: float, P: np.ndarray) -> float:
+    """k_z(p) of a healthy pair, N/m: single/double contact from the contact ratio, or a periodic table."""
+    if P[I_KIND] == PROFILE_CONTACT_RATIO:
+        h = P[I_HALF_DOUBLE]
+        return P[I_KDOUBLE] if (p < h or p >= 1.0 - h) else P[I_KSINGLE]
+    z1, z2, n = int(P[I_Z1]), int(P[I_Z2]), int(P[I_NTAB])
+    o = I_HEADER + 2 * z1 + z2
+    ph = P[o:o + n]
+    kk = P[o + n:o + 2 * n]
+    if p < ph[0]:  # wrap between the last point (shifted by -1) and the first
+        x0, k0, x1, k1 = ph[n - 1] - 1.0, kk[n - 1], ph[0], kk[0]
+    elif p >= ph[n - 1]:
+        x0, k0, x1, k1 = ph[n - 1], kk[n - 1], ph[0] + 1.0, kk[0]
+    else:
+        m = np.searchsorted(ph, p, side="right") - 1
+        x0, k0, x1, k1 = ph[m], kk[m], ph[m + 1], kk[m + 1]
+    return k0 + (k1 - k0) * (p - x0) / (x1 - x0)
+
+
+@njit(cache=True)
+def error_shape(p: float, a: float) -> float:
+    """Triangular error shape of Fig. 4 (b, c): 0 at p = 0 and 1, maximum 1 at p = a."""
+    if p < a:
+        return p / a
+    return (1.0 - p) / (1.0 - a) if a < 1.0 else 1.0
+
+
+@njit(cache=True)
+def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float, P: np.ndarray):
+    """Normal mesh force F (N, elastic + damping), friction force T (N) and arms rho_1, rho_2 (m).
+
+    ``pinion_angle_rad`` sets the mesh phase and the teeth in mesh; ``delta_m`` is the deflection
+    along the line of action (r1 phi_p - r2 phi_w, plus centre motions in lateral models).
+    """
+    z1, z2 = int(P[I_Z1]), int(P[I_Z2])
+    u = pinion_angle_rad * z1 / (2.0 * math.pi)
+    n = math.floor(u)
+    p = u - n
+    i = int(n % z1)
+    j = int(n % z2)
+    factor = P[I_HEADER + z1 + i] * P[I_HEADER + 2 * z1 + j]
+    k = stiffness_at_phase(p, P) * factor
+    d = delta_m + P[I_HEADER + i] * error_shape(p, P[I_A])
+    lu = P[I_LU]
+    if d > lu:
+        F = k * (d - lu) + P[I_CZ] * factor * delta_rate_m_s
+    elif d < -lu:
+        F = k * (d + lu) + P[I_CZ] * factor * delta_rate_m_s
+    else:
+        F = 0.0
+    dp = p - P[I_PITCH]
+    T = P[I_MU] * F if dp < 0.0 else -P[I_MU] * F
+    rho1 = P[I_ARM1] + dp * P[I_PB]
+    rho2 = P[I_ARM2] - dp * P[I_PB]
+    return F, T, rho1, rho2
+
+
+@njit(cache=True)
+def torsional_mesh_forces(phi_p: float, phi_w: float, w_p: float, w_w: float, P: np.ndarray):
+    """Generalised mesh moments on pinion and wheel (N m), eq. (1): -r1 F + T rho_1, r2 F - T rho_2."""
+    r1, r2 = P[I_R1], P[I_R2]
+    F, T, rho1, rho2 = mesh_contact(phi_p, r1 * phi_p - r2 * phi_w, r1 * w_p - r2 * w_w, P)
+    return -r1 * F + T * rho1, r2 * F - T * rho2
+
+
+@njit(cache=True)
+def mesh_contact_series(pinion_angle_rad: np.ndarray, delta_m: np.ndarray, delta_rate_m_s: np.ndarray,
+                        P: np.ndarray):
+    """:func:`mesh_contact` over arrays: returns (F, T) in N."""
+    nt = pinion_angle_rad.size
+    F = np.empty(nt)
+    T = np.empty(nt)
+    for m in range(nt):
+        F[m], T[m], _, _ = mesh_contact(pinion_angle_rad[m], delta_m[m], delta_rate_m_s[m], P)
+    return F, T
+
+
+@njit(cache=True)
+def mesh_phase_series(pinion_angle_rad: np.ndarray, P: np.ndarray):
+    """Mesh phase p in [0, 1), pinion tooth i and wheel tooth j in mesh, for each angle."""
+    z1, z2 = int(P[I_Z1]), int(P[I_Z2])
+    nt = pinion_angle_rad.size
+    p = np.empty(nt)
+    i = np.empty(nt, np.int64)
+    j = np.empty(nt, np.int64)
+    for m in range(nt):
+        u = pinion_angle_rad[m] * z1 / (2.0 * math.pi)
+        n = math.floor(u)
+        p[m] = u - n
+        i[m] = int(n % z1)
+        j[m] = int(n % z2)
+    return p, i, j
+
+
+def mean_stiffness_N_per_m(P: np.ndarray, samples: int = 4096) -> float:
+    """Mean of k_z(p) over one mesh period (healthy teeth), for linearised modes."""
+    ps = (np.arange(samples) + 0.5) / samples
+    return float(np.mean([stiffness_at_phase(p, P) for p in ps]))

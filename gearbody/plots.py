@@ -1,0 +1,183 @@
+"""PNG plots of K_d and spectra (as the paper's Figs. 6-8, 12 and 13-16).
+
+Uses matplotlib's Agg canvas directly (no pyplot, no display, global backend untouched). Every function
+writes one PNG of exactly ``size_px`` pixels and returns its path. Engine-free: plain arrays in.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
+
+from gearbody.analysis.dynamic_factor import INSTABILITY_KD, FoldedSignal
+from gearbody.analysis.spectrum import Spectrum, mesh_harmonics
+
+__all__ = ["harmonic_labels", "plot_kd_folded", "plot_kd_time", "plot_spectrum"]
+
+PathLike = str | os.PathLike[str]
+DEFAULT_SIZE_PX: tuple[int, int] = (1000, 600)
+
+
+def _figure(size_px: tuple[int, int], dpi: int) -> Figure:
+    width_px, height_px = size_px
+    if width_px < 1 or height_px < 1 or dpi < 1:
+        raise ValueError(f"size_px and dpi must be positive, got {size_px}, {dpi}")
+    fig = Figure(figsize=(width_px / dpi, height_px / dpi), dpi=dpi, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _save(fig: Figure, path: PathLike, dpi: int) -> Path:
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=dpi, format="png")  # no bbox_inches="tight": keeps the requested pixel size
+    return out
+
+
+def _threshold_line(ax, kd_threshold: float | None) -> None:
+    if kd_threshold is not None:
+        ax.axhline(
+            kd_threshold,
+            color="tab:red",
+            linestyle="--",
+            linewidth=1.0,
+            label=f"K_d = {kd_threshold:g} (instability)",
+        )
+
+
+def harmonic_labels(count: int, symbol: str = "f_z") -> list[str]:
+    """Labels "f_z", "2f_z", ..., for the first ``count`` harmonics of ``symbol``."""
+    return [symbol if k == 1 else f"{k}{symbol}" for k in range(1, count + 1)]
+
+
+def plot_kd_time(
+    time_s: ArrayLike,
+    kd: ArrayLike,
+    path: PathLike,
+    title: str = "",
+    boundaries_s: Sequence[float] = (),
+    kd_threshold: float | None = INSTABILITY_KD,
+    size_px: tuple[int, int] = DEFAULT_SIZE_PX,
+    dpi: int = 100,
+) -> Path:
+    """K_d [-] against time [s] (as Fig. 12); optional operating-period boundaries and K_d = 2 line."""
+    fig = _figure(size_px, dpi)
+    ax = fig.add_subplot()
+    ax.plot(np.asarray(time_s, dtype=float), np.asarray(kd, dtype=float), linewidth=0.6, color="tab:blue")
+    for t in boundaries_s:
+        ax.axvline(t, color="0.5", linestyle=":", linewidth=1.0)
+    _threshold_line(ax, kd_threshold)
+    ax.set_xlabel("Time t [s]")
+    ax.set_ylabel("Dynamic factor K_d [-]")
+    if title:
+        ax.set_title(title)
+    if kd_threshold is not None:
+        ax.legend(loc="upper left")
+    ax.grid(True, alpha=0.3)
+    return _save(fig, path, dpi)
+
+
+def plot_kd_folded(
+    folded: FoldedSignal,
+    path: PathLike,
+    title: str = "",
+    show_range: bool = True,
+    kd_threshold: float | None = None,
+    size_px: tuple[int, int] = DEFAULT_SIZE_PX,
+    dpi: int = 100,
+) -> Path:
+    """Mean K_d [-] over % of the mesh period (as Figs. 6-8), with the min-max band if ``show_range``."""
+    fig = _figure(size_px, dpi)
+    ax = fig.add_subplot()
+    x = folded.percent_of_period
+    if show_range:
+        ax.fill_between(
+            x, folded.minimum, folded.maximum, color="tab:blue", alpha=0.2, linewidth=0, label="min-max"
+        )
+    ax.plot(x, folded.mean, color="tab:blue", linewidth=1.5, label="mean")
+    _threshold_line(ax, kd_threshold)
+    ax.set_xlim(0.0, 100.0)
+    ax.set_xlabel("% of mesh period")
+    ax.set_ylabel("K_d [-]")
+    if title:
+        ax.set_title(title)
+    ax.legend(loc="upper right")
+    ax.grid(True, alpha=0.3)
+    return _save(fig, path, dpi)
+
+
+def plot_spectrum(
+    spectrum: Spectrum,
+    path: PathLike,
+    mesh_frequency_hz: float | None = None,
+    shaft_frequencies_hz: Sequence[float] | Mapping[str, float] = (),
+    title: str = "",
+    fmax_hz: float | None = None,
+    ylabel: str = "Amplitude [signal units]",
+    log_amplitude: bool = False,
+    max_harmonics: int = 20,
+    size_px: tuple[int, int] = DEFAULT_SIZE_PX,
+    dpi: int = 100,
+) -> Path:
+    """Amplitude spectrum against frequency [Hz] (as Figs. 13-16, 20).
+
+    Mesh harmonics k f_z <= fmax_hz (at most ``max_harmonics``) are marked by dashed lines labelled
+    f_z, 2f_z, ...; shaft frequencies by dotted lines, labelled by the mapping keys (plain text)
+    or f_s1, f_s2, ....
+    ``log_amplitude`` uses a log y axis (bins below 1e-9 of the maximum are clipped to it).
+    Pass ``ylabel`` with the signal's unit, e.g. "Acceleration amplitude [m/s^2]".
+    """
+    fmax = float(spectrum.frequency_hz[-1]) if fmax_hz is None else float(fmax_hz)
+    shown = spectrum.frequency_hz <= fmax
+    freq = spectrum.frequency_hz[shown]
+    amp = spectrum.amplitude[shown]
+
+    fig = _figure(size_px, dpi)
+    ax = fig.add_subplot()
+    if log_amplitude:
+        peak = float(np.max(amp)) if amp.size and np.max(amp) > 0 else 1.0
+        amp = np.maximum(amp, peak * 1e-9)
+        ax.set_yscale("log")
+    ax.plot(freq, amp, color="tab:blue", linewidth=0.8)
+    label_transform = ax.get_xaxis_transform()  # x in data, y in axes fraction
+
+    if mesh_frequency_hz is not None:
+        harmonics = mesh_harmonics(mesh_frequency_hz, fmax)[:max_harmonics]
+        for f, label in zip(harmonics, harmonic_labels(harmonics.size), strict=True):
+            ax.axvline(f, color="tab:red", linestyle="--", linewidth=0.8, alpha=0.8)
+            ax.text(
+                f,
+                1.0,
+                f"${label}$",
+                transform=label_transform,
+                ha="center",
+                va="bottom",
+                color="tab:red",
+                fontsize=8,
+                clip_on=False,
+            )
+
+    if isinstance(shaft_frequencies_hz, Mapping):
+        shafts = [(str(k), float(v)) for k, v in shaft_frequencies_hz.items()]
+    else:
+        shafts = [(f"$f_{{s{i}}}$", float(v)) for i, v in enumerate(shaft_frequencies_hz, start=1)]
+    for label, f in shafts:
+        if f <= fmax:
+            ax.axvline(f, color="tab:green", linestyle=":", linewidth=1.0)
+            ax.text(
+                f, 0.97, label, transform=label_transform, ha="left", va="top", color="tab:green", fontsize=8
+            )
+
+    ax.set_xlim(0.0, fmax)
+    ax.set_xlabel("Frequency f [Hz]")
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title, pad=14 if mesh_frequency_hz is not None else 6)
+    ax.grid(True, alpha=0.3)
+    return _save(fig, path, dpi)

@@ -1,0 +1,86 @@
+"""What a diagnostician reads first about a run: K_d, separation, mesh frequency, speed. Engine-free.
+
+"Final" values are taken over the last quarter of the simulated time (the steady, rated-load
+period in the scenes' four-period operation); whole-run values say so in their name.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from . import plots
+from .analysis import amplitude_spectrum, fold_over_mesh_period, separation_stats
+from .result import Result
+
+FINAL_FRACTION = 0.25
+
+
+def final_window(result: Result, fraction: float = FINAL_FRACTION) -> np.ndarray:
+    """Boolean mask of the last ``fraction`` of the simulated time."""
+    t = result.time_s
+    return t >= t[-1] - fraction * (t[-1] - t[0])
+
+
+def pinion_angle(result: Result) -> np.ndarray:
+    return result["pinion_angle_rad"]
+
+
+def vibration_signal(result: Result) -> tuple[str, np.ndarray]:
+    """The acceleration signal whose spectrum is shown: pinion angular acceleration (Muller: deflection)."""
+    name = "pinion_accel_rad_s2" if "pinion_accel_rad_s2" in result else "deflection_accel_m_s2"
+    return name, result[name]
+
+
+def summarize(result: Result) -> dict[str, Any]:
+    """Summary values of a run (see module docstring for the windows)."""
+    win = final_window(result)
+    sep = separation_stats(result.mesh_force, result.time_s, kd=result.kd)
+    speed = (result["pinion_speed_rad_s"] if "pinion_speed_rad_s" in result
+             else 2 * math.pi * result["mesh_frequency_hz"] / result.meta["pinion_teeth"])
+    stats = result.meta.get("solver_statistics", {})
+    return {
+        "scene": result.meta.get("scene"),
+        "kd_max": float(np.max(result.kd)),
+        "kd_min": float(np.min(result.kd)),
+        "kd_max_final": float(np.max(result.kd[win])),
+        "kd_mean_final": float(np.mean(result.kd[win])),
+        "kd_above_2": bool(np.max(result.kd) > 2.0),
+        "separation_fraction": float(sep.separated_fraction),
+        "contact_losses": int(sep.contact_losses),
+        "mesh_frequency_hz": float(np.mean(result["mesh_frequency_hz"][win])),
+        "mean_speed_rad_s": float(np.mean(speed[win])),
+        "rated_mesh_force_N": float(result.meta.get("rated_mesh_force_N", float("nan"))),
+        "simulated_time_s": float(result.time_s[-1] - result.time_s[0]),
+        "wall_time_s": float(stats.get("wall_time_s", float("nan"))),
+        "wall_s_per_simulated_s": float(stats.get("wall_time_s", float("nan")))
+        / max(float(result.time_s[-1] - result.time_s[0]), 1e-300),
+        "solver_steps": int(stats.get("steps", 0)),
+        "solver_rejected_steps": int(stats.get("rejected_steps", 0)),
+        "seed": result.meta.get("seed"),
+    }
+
+
+def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
+    """K_d over time, K_d folded over the mesh period (final window), spectrum of the acceleration."""
+    out = Path(out_dir)
+    title = result.meta.get("title", result.meta.get("scene", ""))
+    paths = [plots.plot_kd_time(result.time_s, result.kd, out / "kd_time.png", title=f"{title}: K_d = F(t)/F_rated")]
+    win = final_window(result)
+    folded = fold_over_mesh_period(result.kd[win], pinion_angle(result)[win], int(result.meta["pinion_teeth"]))
+    paths.append(plots.plot_kd_folded(folded, out / "kd_folded.png",
+                                      title=f"{title}: K_d over the mesh period (last {FINAL_FRACTION:.0%} of run)"))
+    name, signal = vibration_signal(result)
+    spec = amplitude_spectrum(signal[win], result.sample_rate_hz)
+    f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
+    z1, z2 = int(result.meta["pinion_teeth"]), int(result.meta["wheel_teeth"])
+    shafts = {"f_1": f_mesh / z1, "f_2": f_mesh / z2} if f_mesh > 0 else {}
+    unit = "rad/s²" if name.endswith("rad_s2") else "m/s²"
+    paths.append(plots.plot_spectrum(spec, out / "spectrum.png", mesh_frequency_hz=f_mesh if f_mesh > 0 else None,
+                                     shaft_frequencies_hz=shafts, title=f"{title}: spectrum of {name}",
+                                     fmax_hz=min(result.sample_rate_hz / 2, 8 * f_mesh if f_mesh > 0 else 1e9),
+                                     ylabel=f"amplitude [{unit}]", log_amplitude=True))
+    return paths

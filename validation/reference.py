@@ -1,0 +1,724 @@
+"""Independent reference model for the gearbody scenes ``muller``, ``two-wheel`` and ``one-stage``.
+
+Written directly from ``docs/scenario.md`` (the contract) as a first-order ODE system and integrated
+with :func:`scipy.integrate.solve_ivp`.  It deliberately shares no code with ``gearbody``.
+
+Discontinuities
+---------------
+The mesh stiffness, the per-tooth factors, the error branch, the friction sign and (with backlash)
+the contact state all change discontinuously with the pinion angle / mesh deflection.  Plain
+adaptive stepping across such jumps is first order and slow, so the integration is done segment by
+segment in *locked modes*:
+
+* phase mode ``(n, k)``: the pinion mesh coordinate ``u = phi_p z1 / (2 pi)`` lies in
+  ``[n + b_k, n + b_{k+1})`` where ``b`` are all phase break points in one mesh period (0, h, 1-h,
+  pitch_point_phase, error apex ``a``, table points).  Inside such an interval every mesh quantity
+  is a polynomial (at most linear) function of ``p = u - n`` and is evaluated from that formula,
+  so the right-hand side is smooth, also a little beyond the interval ends during trial steps;
+* contact mode ``c`` in {+1 flank contact, 0 separated, -1 back-flank contact}; only used when the
+  backlash ``l_u > 0`` (with ``l_u = 0`` the spring law ``k d`` is linear and damping is on for all
+  ``d != 0``, so there is nothing to switch).
+
+``solve_ivp`` stops exactly at each mode boundary (terminal ``events``), the mode is switched and
+the integration restarts from the event state.  The event functions carry a tiny hysteresis (1e-10
+of a mesh period, 1e-15 m of deflection) so that a state resting exactly on a boundary (e.g. a gear
+at standstill at u = 0) cannot trigger an endless chain of zero-length segments.  The time break
+points of the speed and load profiles are also segment boundaries.
+
+The mesh force at the output times is evaluated from the (dense-output) states at those times with
+the very same function (``_mesh_force``) that the right-hand side uses, in the mode that was active
+when the sample time was reached.
+"""
+
+from __future__ import annotations
+
+import math
+
+try:  # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover
+    import tomli as tomllib
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+__all__ = [
+    "load_scenario",
+    "simulate_reference",
+    "F_rated",
+    "profile_value",
+    "profile_integral",
+    "kloss_torque",
+    "steady_slip",
+    "random_l",
+    "tooth_error_amplitudes",
+    "error_shape",
+    "base_stiffness",
+    "tooth_factors",
+    "reduced_mass",
+    "mesh_force_literal",
+    "friction_moments",
+    "initial_state",
+    "phase_breakpoints",
+]
+
+TWO_PI = 2.0 * math.pi
+_ETA_U = 1e-10  # event hysteresis in mesh periods
+_ETA_D = 1e-15  # event hysteresis in metres of mesh deflection
+_MAX_ZERO_SEGMENTS = 1000
+
+
+# ----------------------------------------------------------------------------------------------
+# Scenario helpers (each is a literal transcription of one sentence of docs/scenario.md)
+# ----------------------------------------------------------------------------------------------
+def load_scenario(path) -> dict:
+    """Read a (resolved) scenario TOML file."""
+    with open(path, "rb") as fh:
+        return tomllib.load(fh)
+
+
+def F_rated(scenario: dict) -> float:
+    """F_rated = machine.rated_torque_Nm / r2."""
+    d = scenario["design"]
+    return float(d["machine"]["rated_torque_Nm"]) / float(d["wheel"]["base_radius_m"])
+
+
+def _profile_arrays(profile: dict) -> tuple[np.ndarray, np.ndarray]:
+    times = np.asarray(profile["time_s"], dtype=float).ravel()
+    fr = np.asarray(profile["fraction"], dtype=float).ravel()
+    if times.size == 0 or times.size != fr.size:
+        raise ValueError("profile needs equally long, non-empty time_s and fraction")
+    if np.any(np.diff(times) < 0):
+        raise ValueError("profile time_s must be non-decreasing")
+    return times, fr
+
+
+def profile_value(t, profile: dict):
+    """Piecewise linear through the points, held constant before the first / after the last."""
+    times, fr = _profile_arrays(profile)
+    return np.interp(t, times, fr)
+
+
+def profile_integral(t, profile: dict):
+    """Exact integral of the profile from 0 to t (t >= 0)."""
+    times, fr = _profile_arrays(profile)
+    tt = np.atleast_1d(np.asarray(t, dtype=float))
+    out = np.empty_like(tt)
+    for m, tm in enumerate(tt):
+        if tm < 0:
+            raise ValueError("profile_integral needs t >= 0")
+        pts = np.unique(np.concatenate(([0.0, tm], times[(times > 0.0) & (times < tm)])))
+        vals = np.interp(pts, times, fr)
+        out[m] = float(np.sum(0.5 * (vals[1:] + vals[:-1]) * np.diff(pts)))
+    return out if np.ndim(t) else float(out[0])
+
+
+def kloss_torque(w, ws_t: float, motor: dict):
+    """Kloss torque M_s = 2 M_b s s_b / (s^2 + s_b^2), s = (w_s(t) - w) / synchronous_speed_rad_s."""
+    wsr = float(motor["synchronous_speed_rad_s"])
+    mb = float(motor["breakdown_torque_Nm"])
+    sb = float(motor["breakdown_slip"])
+    s = (ws_t - np.asarray(w, dtype=float)) / wsr
+    return 2.0 * mb * s * sb / (s * s + sb * sb)
+
+
+def steady_slip(m_p: float, motor: dict) -> float:
+    """Stable-branch slip with M_s = m_p: s = s_b (M_b - sqrt(M_b^2 - M_p^2)) / M_p, 0 for M_p = 0."""
+    mb = float(motor["breakdown_torque_Nm"])
+    sb = float(motor["breakdown_slip"])
+    if m_p == 0.0:
+        return 0.0
+    if abs(m_p) > mb:
+        raise ValueError(f"pinion torque {m_p} exceeds the breakdown torque {mb}: no steady state")
+    return sb * (mb - math.sqrt(mb * mb - m_p * m_p)) / m_p
+
+
+def random_l(seed: int, z1: int) -> np.ndarray:
+    """l = numpy.random.default_rng(seed).random(z1)."""
+    return np.random.default_rng(seed).random(z1)
+
+
+def tooth_error_amplitudes(scenario: dict) -> np.ndarray:
+    """e_i = [1 - r (1 - l[i])] e in metres, one per pinion tooth."""
+    em = scenario["production"]["error_mode"]
+    z1 = int(scenario["design"]["pinion"]["teeth"])
+    l_rand = random_l(int(scenario["meta"]["seed"]), z1)
+    return (1.0 - float(em["r"]) * (1.0 - l_rand)) * float(em["e_um"]) * 1e-6
+
+
+def error_shape(p, a: float, e_i):
+    """Triangular error E: e_i p / a for p < a, e_i (1 - p) / (1 - a) for p >= a."""
+    p = np.asarray(p, dtype=float)
+    e_i = np.asarray(e_i, dtype=float)
+    rise = e_i * p / a if a > 0.0 else np.zeros(np.broadcast(p, e_i).shape)
+    fall = e_i * (1.0 - p) / (1.0 - a) if a < 1.0 else np.zeros(np.broadcast(p, e_i).shape)
+    return np.where(p < a, rise, fall)
+
+
+def base_stiffness(p, mesh: dict):
+    """k_z(p) without tooth factors ("contact-ratio" or "table")."""
+    p = np.asarray(p, dtype=float)
+    prof = mesh["stiffness_profile"]
+    if prof == "contact-ratio":
+        h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
+        double = (p < h) | (p >= 1.0 - h)
+        return np.where(double, float(mesh["stiffness_double_N_per_m"]), float(mesh["stiffness_single_N_per_m"]))
+    if prof == "table":
+        ph = np.asarray(mesh["table_phase"], dtype=float)
+        kk = np.asarray(mesh["table_stiffness_N_per_m"], dtype=float)
+        if ph.size == 0 or ph.size != kk.size:
+            raise ValueError("table stiffness profile needs equally long, non-empty tables")
+        return np.interp(p, ph, kk, period=1.0)
+    raise ValueError(f"unknown stiffness_profile {prof!r}")
+
+
+def tooth_factors(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
+    """f (pinion, z1 values) and g (wheel, z2 values); 1 unless listed in condition.damaged_teeth.
+
+    A tooth listed more than once gets the product of its factors (assumption, see report).
+    """
+    z1 = int(scenario["design"]["pinion"]["teeth"])
+    z2 = int(scenario["design"]["wheel"]["teeth"])
+    f = np.ones(z1)
+    g = np.ones(z2)
+    for entry in scenario["condition"].get("damaged_teeth", []):
+        arr = {"pinion": f, "wheel": g}[entry["gear"]]
+        tooth = int(entry["tooth"])
+        if not 0 <= tooth < arr.size:
+            raise ValueError(f"damaged tooth index {tooth} out of range for the {entry['gear']}")
+        arr[tooth] *= float(entry["stiffness_factor"])
+    return f, g
+
+
+def reduced_mass(scenario: dict) -> float:
+    """m = 1 / (r1^2 / I_1p + r2^2 / I_2p)."""
+    d = scenario["design"]
+    r1, r2 = float(d["pinion"]["base_radius_m"]), float(d["wheel"]["base_radius_m"])
+    i1, i2 = float(d["pinion"]["inertia_kg_m2"]), float(d["wheel"]["inertia_kg_m2"])
+    return 1.0 / (r1 * r1 / i1 + r2 * r2 / i2)
+
+
+def mesh_force_literal(scenario: dict, u, delta, delta_dot) -> dict:
+    """Vectorised, literal transcription of the mesh-force paragraph (used by the self-checks).
+
+    u: pinion mesh coordinate phi_p z1 / (2 pi); delta = r1 phi_p - r2 phi_w; delta_dot its rate.
+    """
+    d_ = scenario["design"]
+    mesh = d_["mesh"]
+    z1, z2 = int(d_["pinion"]["teeth"]), int(d_["wheel"]["teeth"])
+    u = np.asarray(u, dtype=float)
+    n = np.floor(u).astype(np.int64)
+    p = u - n
+    i = np.mod(n, z1)
+    j = np.mod(n, z2)
+    f, g = tooth_factors(scenario)
+    k = base_stiffness(p, mesh) * f[i] * g[j]
+    e_i = tooth_error_amplitudes(scenario)[i]
+    E = error_shape(p, float(scenario["production"]["error_mode"]["a"]), e_i)
+    d = np.asarray(delta, dtype=float) + E
+    lu = float(mesh["backlash_um"]) * 1e-6
+    F_el = k * np.maximum(d - lu, np.minimum(d + lu, 0.0))
+    contact = np.abs(d) > lu
+    F_t = np.where(contact, float(mesh["damping_Ns_per_m"]) * f[i] * g[j] * np.asarray(delta_dot, float), 0.0)
+    return {"F": F_el + F_t, "F_el": F_el, "F_t": F_t, "p": p, "i": i, "j": j, "k": k, "E": E, "d": d}
+
+
+def friction_moments(scenario: dict, p, F) -> dict:
+    """T = mu F s and the moments M_zt1 = T rho_1, M_zt2 = T rho_2 (literal)."""
+    d_ = scenario["design"]
+    mesh = d_["mesh"]
+    r1, r2 = float(d_["pinion"]["base_radius_m"]), float(d_["wheel"]["base_radius_m"])
+    z1 = int(d_["pinion"]["teeth"])
+    ppp = float(mesh["pitch_point_phase"])
+    tan_a = math.tan(math.radians(float(mesh["pressure_angle_deg"])))
+    pb = TWO_PI * r1 / z1
+    p = np.asarray(p, dtype=float)
+    s = np.where(p < ppp, 1.0, -1.0)
+    T = float(scenario["condition"]["friction_coefficient"]) * np.asarray(F, dtype=float) * s
+    rho1 = r1 * tan_a + (p - ppp) * pb
+    rho2 = r2 * tan_a - (p - ppp) * pb
+    return {"T": T, "rho1": rho1, "rho2": rho2, "M_zt1": T * rho1, "M_zt2": T * rho2}
+
+
+def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Initial coordinates and velocities for initial_state "rest" | "steady"."""
+    scene = scenario["meta"]["scene"]
+    n_dof = {"muller": 1, "two-wheel": 2, "one-stage": 4}[scene]
+    kind = scenario["operation"]["initial_state"]
+    q0 = np.zeros(n_dof)
+    v0 = np.zeros(n_dof)
+    if kind == "rest":
+        return q0, v0
+    if kind != "steady":
+        raise ValueError(f"unknown initial_state {kind!r}")
+    d_ = scenario["design"]
+    r1, r2 = float(d_["pinion"]["base_radius_m"]), float(d_["wheel"]["base_radius_m"])
+    mesh = d_["mesh"]
+    lu = float(mesh["backlash_um"]) * 1e-6
+    M_L = float(d_["machine"]["rated_torque_Nm"]) * float(profile_value(0.0, scenario["operation"]["load_profile"]))
+    F0 = M_L / r2
+    M_p = F0 * r1
+    f, g = tooth_factors(scenario)
+    k0 = float(base_stiffness(0.0, mesh)) * f[0] * g[0]
+    delta0 = F0 / k0 + lu if F0 != 0.0 else 0.0
+    if scene == "muller":
+        q0[0] = delta0
+        return q0, v0
+    motor = d_["motor"]
+    wsr = float(motor["synchronous_speed_rad_s"])
+    ws0 = wsr * float(profile_value(0.0, scenario["operation"]["speed_profile"]))
+    w = ws0 - steady_slip(M_p, motor) * wsr
+    if scene == "two-wheel":
+        q0[:] = [0.0, -delta0 / r2]
+        v0[:] = [w, w * r1 / r2]
+        return q0, v0
+    k1 = float(d_["coupling"]["stiffness_Nm_per_rad"])
+    k2 = float(d_["output_shaft"]["stiffness_Nm_per_rad"])
+    phi3 = -delta0 / r2
+    q0[:] = [M_p / k1, 0.0, phi3, phi3 - M_L / k2]
+    v0[:] = [w, w, w * r1 / r2, w * r1 / r2]
+    return q0, v0
+
+
+def phase_breakpoints(scenario: dict) -> np.ndarray:
+    """All phases in [0, 1) at which some mesh quantity jumps or kinks (0 always included)."""
+    mesh = scenario["design"]["mesh"]
+    pts = [0.0]
+    if mesh["stiffness_profile"] == "contact-ratio":
+        h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
+        pts += [h, 1.0 - h]
+    else:
+        pts += [float(x) % 1.0 for x in mesh["table_phase"]]
+    pts.append(float(scenario["production"]["error_mode"]["a"]))
+    if scenario["meta"]["scene"] != "muller" and float(scenario["condition"]["friction_coefficient"]) != 0.0:
+        pts.append(float(mesh["pitch_point_phase"]))
+    pts = np.unique([x for x in pts if 0.0 <= x < 1.0])
+    return pts
+
+
+# ----------------------------------------------------------------------------------------------
+# Locked-mode mesh law (used by the right-hand side AND for the outputs)
+# ----------------------------------------------------------------------------------------------
+def _mesh_force(mc: tuple, p, delta, delta_dot):
+    """Mesh force F = F_el + F_t in a locked mode; works on floats and on numpy arrays.
+
+    mc = (fg, kA, kS, bA, e_i, Ea, Eb, c, lu, Cf): effective stiffness fg (kA + kS (p - bA)),
+    error e_i (Ea + Eb p), contact mode c (0: separated), half backlash lu, damping Cf = C_z fg.
+    """
+    fg, kA, kS, bA, e_i, Ea, Eb, c, lu, Cf = mc
+    if c == 0:
+        return 0.0 * (p + delta + delta_dot)
+    d = delta + e_i * (Ea + Eb * p)
+    return fg * (kA + kS * (p - bA)) * (d - c * lu) + Cf * delta_dot
+
+
+class _Model:
+    """Constants of one resolved scenario, plus the per-mode constants."""
+
+    def __init__(self, sc: dict):
+        self.sc = sc
+        self.scene = sc["meta"]["scene"]
+        if self.scene not in ("muller", "two-wheel", "one-stage"):
+            raise ValueError(f"unknown scene {self.scene!r}")
+        d_ = sc["design"]
+        self.z1 = int(d_["pinion"]["teeth"])
+        self.z2 = int(d_["wheel"]["teeth"])
+        self.r1 = float(d_["pinion"]["base_radius_m"])
+        self.r2 = float(d_["wheel"]["base_radius_m"])
+        self.cz = self.z1 / TWO_PI
+        mesh = d_["mesh"]
+        self.lu = float(mesh["backlash_um"]) * 1e-6
+        self.Cz = float(mesh["damping_Ns_per_m"])
+        self.ppp = float(mesh["pitch_point_phase"])
+        self.tan_a = math.tan(math.radians(float(mesh["pressure_angle_deg"])))
+        self.pb = TWO_PI * self.r1 / self.z1
+        self.mu = float(sc["condition"]["friction_coefficient"]) if self.scene != "muller" else 0.0
+        self.a = float(sc["production"]["error_mode"]["a"])
+        self.f, self.g = tooth_factors(sc)
+        self.e_amp = tooth_error_amplitudes(sc)
+        self.Frated = F_rated(sc)
+        # phase intervals
+        b = phase_breakpoints(sc)
+        self.bA = b
+        self.bB = np.append(b[1:], 1.0)
+        self.K = b.size
+        self.iv = []  # per interval: (kA, kS, Ea, Eb, s)
+        for k in range(self.K):
+            lo, hi = float(self.bA[k]), float(self.bB[k])
+            mid = 0.5 * (lo + hi)
+            if mesh["stiffness_profile"] == "contact-ratio":
+                kA, kS = float(base_stiffness(mid, mesh)), 0.0
+            else:
+                kA = float(base_stiffness(lo, mesh))
+                kS = (float(base_stiffness(hi % 1.0, mesh)) - kA) / (hi - lo)
+            if mid < self.a:
+                Ea, Eb = 0.0, 1.0 / self.a
+            else:
+                Ea, Eb = 1.0 / (1.0 - self.a), -1.0 / (1.0 - self.a)
+            s = 1.0 if mid < self.ppp else -1.0
+            self.iv.append((kA, kS, Ea, Eb, s))
+        # motor / shafts / inertias
+        mot = d_["motor"]
+        self.wsr = float(mot["synchronous_speed_rad_s"])
+        self.Mb = float(mot["breakdown_torque_Nm"])
+        self.sb = float(mot["breakdown_slip"])
+        self.Is = float(mot["inertia_kg_m2"])
+        self.I1 = float(d_["pinion"]["inertia_kg_m2"])
+        self.I2 = float(d_["wheel"]["inertia_kg_m2"])
+        self.Im = float(d_["machine"]["inertia_kg_m2"])
+        self.Mrated = float(d_["machine"]["rated_torque_Nm"])
+        self.k1 = float(d_["coupling"]["stiffness_Nm_per_rad"])
+        self.C1 = float(d_["coupling"]["damping_Nms_per_rad"])
+        self.k2 = float(d_["output_shaft"]["stiffness_Nm_per_rad"])
+        self.C2 = float(d_["output_shaft"]["damping_Nms_per_rad"])
+        self.m_red = reduced_mass(sc)
+        op = sc["operation"]
+        self.speed_prof = op["speed_profile"]
+        self.load_prof = op["load_profile"]
+        self.n_dof = {"muller": 1, "two-wheel": 2, "one-stage": 4}[self.scene]
+        # scales for the default absolute tolerance
+        kmax = max(float(np.max(base_stiffness(np.linspace(0, 1, 201), mesh))), 1.0)
+        self.defl_scale = max(self.Frated / kmax, 1e-7)
+        self.omega_n = math.sqrt(kmax / self.m_red)
+
+    # -- mode constants ---------------------------------------------------------------------
+    def mode_consts(self, n: int, k: int, c: int) -> tuple:
+        kA, kS, Ea, Eb, _s = self.iv[k]
+        fg = self.f[n % self.z1] * self.g[n % self.z2]
+        e_i = self.e_amp[n % self.z1]
+        return (fg, kA, kS, float(self.bA[k]), e_i, Ea, Eb, c, self.lu, self.Cz * fg)
+
+    def phase_mode(self, u: float, u_dot: float) -> tuple[int, int]:
+        n = math.floor(u)
+        p = u - n
+        k = int(np.searchsorted(self.bA, p, side="right")) - 1
+        if p == self.bA[k] and u_dot < 0.0:  # sitting on a boundary and moving down
+            k -= 1
+            if k < 0:
+                k, n = self.K - 1, n - 1
+        return n, k
+
+    def contact_mode(self, d: float, d_dot: float) -> int:
+        lu = self.lu
+        if lu == 0.0:
+            return 1
+        if d > lu or (d == lu and d_dot > 0):
+            return 1
+        if d < -lu or (d == -lu and d_dot < 0):
+            return -1
+        return 0
+
+    # -- kinematics of the mesh per scene (u, delta, delta_dot) ------------------------------
+    def kin(self, t, y, theta):
+        """theta: callable t -> prescribed pinion angle (muller) or None."""
+        if self.scene == "muller":
+            return theta(t) * self.cz, y[0], y[1]
+        ip, iw = (1, 2) if self.scene == "one-stage" else (0, 1)
+        nd = self.n_dof
+        return (
+            y[ip] * self.cz,
+            self.r1 * y[ip] - self.r2 * y[iw],
+            self.r1 * y[nd + ip] - self.r2 * y[nd + iw],
+        )
+
+    def u_dot(self, t, y, chunk) -> float:
+        if self.scene == "muller":
+            return chunk["ws"](t) * self.cz
+        ip = 1 if self.scene == "one-stage" else 0
+        return y[self.n_dof + ip] * self.cz
+
+    # -- right-hand sides ----------------------------------------------------------------------
+    def make_rhs(self, n: int, k: int, c: int, chunk: dict):
+        mc = self.mode_consts(n, k, c)
+        s = self.iv[k][4]
+        mus = self.mu * s
+        ta, sa, ss, la, ls = chunk["ta"], chunk["sa"], chunk["ss"], chunk["la"], chunk["ls"]
+        wsr, Mb, sb = self.wsr, self.Mb, self.sb
+        sbsq = sb * sb
+        Mrated = self.Mrated
+        r1, r2, cz = self.r1, self.r2, self.cz
+        ppp, pb = self.ppp, self.pb
+        r1tan, r2tan = r1 * self.tan_a, r2 * self.tan_a
+        mesh = _mesh_force
+        nf = float(n)
+        array = np.array
+
+        if self.scene == "muller":
+            m = self.m_red
+            Fr = self.Frated
+            th_a = chunk["theta_a"]
+
+            def rhs(t, y):
+                x, v = y.tolist()
+                tau = t - ta
+                u = (th_a + wsr * (sa * tau + 0.5 * ss * tau * tau)) * cz
+                F = mesh(mc, u - nf, x, v)
+                return array([v, (Fr * (la + ls * tau) - F) / m])
+
+            return rhs, mc
+
+        if self.scene == "two-wheel":
+            J1 = self.Is + self.I1
+            J2 = self.I2 + self.Im
+
+            def rhs(t, y):
+                p1, p2, w1, w2 = y.tolist()
+                tau = t - ta
+                p = p1 * cz - nf
+                F = mesh(mc, p, r1 * p1 - r2 * p2, r1 * w1 - r2 * w2)
+                T = mus * F
+                q = (p - ppp) * pb
+                slip = (wsr * (sa + ss * tau) - w1) / wsr
+                Ms = 2.0 * Mb * sb * slip / (slip * slip + sbsq)
+                Mr = Mrated * (la + ls * tau)
+                return array([w1, w2, (Ms - r1 * F + T * (r1tan + q)) / J1, (r2 * F - T * (r2tan - q) - Mr) / J2])
+
+            return rhs, mc
+
+        Is, I1, I2, Im = self.Is, self.I1, self.I2, self.Im
+        k1, C1, k2, C2 = self.k1, self.C1, self.k2, self.C2
+
+        def rhs(t, y):
+            p1, p2, p3, p4, w1, w2, w3, w4 = y.tolist()
+            tau = t - ta
+            p = p2 * cz - nf
+            F = mesh(mc, p, r1 * p2 - r2 * p3, r1 * w2 - r2 * w3)
+            T = mus * F
+            q = (p - ppp) * pb
+            slip = (wsr * (sa + ss * tau) - w1) / wsr
+            Ms = 2.0 * Mb * sb * slip / (slip * slip + sbsq)
+            M1 = k1 * (p1 - p2) + C1 * (w1 - w2)
+            M2 = k2 * (p3 - p4) + C2 * (w3 - w4)
+            Mr = Mrated * (la + ls * tau)
+            return array(
+                [
+                    w1,
+                    w2,
+                    w3,
+                    w4,
+                    (Ms - M1) / Is,
+                    (M1 - r1 * F + T * (r1tan + q)) / I1,
+                    (r2 * F - T * (r2tan - q) - M2) / I2,
+                    (M2 - Mr) / Im,
+                ]
+            )
+
+        return rhs, mc
+
+    # -- events --------------------------------------------------------------------------------
+    def make_events(self, n: int, k: int, c: int, mc: tuple, theta):
+        """Terminal events leaving the locked mode; each carries the resulting mode change."""
+        lo = n + float(self.bA[k]) - _ETA_U
+        hi = n + float(self.bB[k]) + _ETA_U
+        kin = self.kin
+        e_i, Ea, Eb = mc[4], mc[5], mc[6]
+        nf = float(n)
+
+        def ev_up(t, y):
+            return kin(t, y, theta)[0] - hi
+
+        def ev_down(t, y):
+            return kin(t, y, theta)[0] - lo
+
+        ev_up.terminal, ev_up.direction = True, 1.0
+        ev_down.terminal, ev_down.direction = True, -1.0
+        events = [ev_up, ev_down]
+        actions = [("phase", +1), ("phase", -1)]
+        if self.lu > 0.0:
+
+            def dfun(t, y):
+                u, delta, _ = kin(t, y, theta)
+                return delta + e_i * (Ea + Eb * (u - nf))
+
+            lu = self.lu
+            if c == 1:
+                defs = [(-(lu - _ETA_D), -1.0, 0)]
+            elif c == -1:
+                defs = [(lu - _ETA_D, 1.0, 0)]
+            else:
+                defs = [(-(lu + _ETA_D), 1.0, 1), (lu + _ETA_D, -1.0, -1)]
+            for offset, direction, new_c in defs:
+
+                def ev(t, y, offset=offset):
+                    return dfun(t, y) + offset
+
+                ev.terminal, ev.direction = True, direction
+                events.append(ev)
+                actions.append(("contact", new_c))
+        return events, actions
+
+    def deflection(self, n, k, t, y, theta) -> tuple[float, float]:
+        """d = delta + E in mode (n, k) and its rate (for re-classifying the contact mode)."""
+        u, delta, ddot = self.kin(t, y, theta)
+        _, _, _, _, e_i, Ea, Eb, *_ = self.mode_consts(n, k, 0)
+        return delta + e_i * (Ea + Eb * (u - n)), ddot
+
+    def default_atol(self, rtol: float) -> np.ndarray:
+        if self.scene == "muller":
+            return np.array([1.0, self.omega_n]) * rtol * self.defl_scale
+        ang = rtol * self.defl_scale / max(self.r1, self.r2)
+        return np.concatenate((np.full(self.n_dof, ang), np.full(self.n_dof, ang * self.omega_n)))
+
+
+def _chunk(model: _Model, ta: float, tb: float, theta_a: float) -> dict:
+    """Linear pieces of the speed and load profiles on [ta, tb] (no profile break point inside)."""
+
+    def lin(profile):
+        # evaluated inside the chunk, so that a step (repeated time) at either end is taken correctly
+        q1, q3 = ta + 0.25 * (tb - ta), ta + 0.75 * (tb - ta)
+        v1, v3 = float(profile_value(q1, profile)), float(profile_value(q3, profile))
+        slope = (v3 - v1) / (q3 - q1)
+        return v1 - slope * (q1 - ta), slope
+
+    sa, ss = lin(model.speed_prof)
+    la, ls = lin(model.load_prof)
+    wsr = model.wsr
+
+    def ws(t):
+        return wsr * (sa + ss * (t - ta))
+
+    return {"ta": ta, "tb": tb, "sa": sa, "ss": ss, "la": la, "ls": ls, "theta_a": theta_a, "ws": ws}
+
+
+def simulate_reference(
+    scenario: dict,
+    t_eval: np.ndarray | None = None,
+    *,
+    rtol: float = 1e-10,
+    atol: float | np.ndarray | None = None,
+    method: str = "DOP853",
+) -> dict[str, np.ndarray]:
+    """Integrate a resolved scenario; see the module docstring.
+
+    Returns time, coordinates and velocities (n_dof x n_t), mesh_force_N (F = F_el + F_t),
+    kd = F / F_rated and nfev (0-d array).
+    """
+    model = _Model(scenario)
+    op = scenario["operation"]
+    if t_eval is None:
+        rate = float(scenario["solver"]["output_rate_hz"])
+        n_out = math.floor(float(op["t_end_s"]) * rate)
+        t_eval = np.arange(n_out + 1) / rate
+    t_eval = np.asarray(t_eval, dtype=float).ravel()
+    if t_eval.size == 0 or t_eval[0] < 0.0 or np.any(np.diff(t_eval) < 0.0):
+        raise ValueError("t_eval must be non-empty, non-negative and non-decreasing")
+    t_stop = float(t_eval[-1])
+    if atol is None:
+        atol = model.default_atol(rtol)
+    nd = model.n_dof
+    q0, v0 = initial_state(scenario)
+    y = np.concatenate((q0, v0))
+    n_t = t_eval.size
+    Y = np.full((2 * nd, n_t), np.nan)
+    F_out = np.full(n_t, np.nan)
+
+    # time break points of the profiles
+    tbreaks = {t_stop}
+    for prof in (model.speed_prof, model.load_prof):
+        tbreaks.update(float(x) for x in prof["time_s"] if 0.0 < float(x) < t_stop)
+    tbreaks = sorted(tbreaks)
+
+    # initial modes
+    t = 0.0
+    theta_a = 0.0
+    chunk = _chunk(model, 0.0, tbreaks[0], theta_a) if t_stop > 0 else None
+
+    def make_theta(ch):
+        wsr, ta, sa, ss, tha = model.wsr, ch["ta"], ch["sa"], ch["ss"], ch["theta_a"]
+
+        def theta(tt):
+            tau = tt - ta
+            return tha + wsr * (sa * tau + 0.5 * ss * tau * tau)
+
+        return theta
+
+    theta = make_theta(chunk) if chunk is not None else (lambda tt: 0.0)
+    u0, _, _ = model.kin(0.0, y, theta)
+    n, k = model.phase_mode(u0, model.u_dot(0.0, y, chunk) if chunk else 0.0)
+    d0, dd0 = model.deflection(n, k, 0.0, y, theta)
+    c = model.contact_mode(d0, dd0)
+
+    nfev = 0
+    i_out = 0
+    h_prev = None
+    zero_segments = 0
+    n_segments = 0
+
+    def fill_outputs(sol, t_lo, t_hi, mc, include_end):
+        nonlocal i_out
+        j = i_out
+        while j < n_t and (t_eval[j] < t_hi or (include_end and t_eval[j] <= t_hi)):
+            j += 1
+        if j > i_out:
+            ts = t_eval[i_out:j]
+            ys = sol(ts) if sol is not None else np.repeat(y[:, None], ts.size, axis=1)
+            Y[:, i_out:j] = ys
+            u, delta, ddot = model.kin(ts, ys, theta)
+            F_out[i_out:j] = _mesh_force(mc, u - n, delta, ddot)
+            i_out = j
+
+    if t_stop == 0.0:
+        _, mc = model.make_rhs(n, k, c, _chunk(model, 0.0, 1.0, 0.0))
+        theta = lambda tt: 0.0  # noqa: E731
+        fill_outputs(None, 0.0, 0.0, mc, True)
+
+    for ib, tb in enumerate(tbreaks):
+        if ib > 0:
+            theta_a = theta(t)
+            chunk = _chunk(model, t, tb, theta_a)
+            theta = make_theta(chunk)
+        last_chunk = ib == len(tbreaks) - 1
+        while t < tb:
+            rhs, mc = model.make_rhs(n, k, c, chunk)
+            events, actions = model.make_events(n, k, c, mc, theta)
+            first = min(h_prev, tb - t) if h_prev else None
+            res = solve_ivp(
+                rhs, (t, tb), y, method=method, rtol=rtol, atol=atol,
+                events=events, dense_output=True, first_step=first,
+            )
+            if res.status < 0:
+                raise RuntimeError(f"solve_ivp failed at t={t}: {res.message}")
+            nfev += int(res.nfev)
+            n_segments += 1
+            t_new = float(res.t[-1])
+            y_new = res.y[:, -1].copy()
+            ts_steps = res.sol.ts
+            if ts_steps.size >= 3:
+                h_prev = float(ts_steps[-2] - ts_steps[-3])
+            elif ts_steps.size == 2 and res.status == 0:
+                h_prev = float(ts_steps[-1] - ts_steps[-2])
+            fill_outputs(res.sol, t, t_new, mc, last_chunk and res.status == 0)
+            if res.status == 1:
+                zero_segments = zero_segments + 1 if t_new == t else 0
+                if zero_segments > _MAX_ZERO_SEGMENTS:
+                    raise RuntimeError(f"mode chattering at t={t_new} (n={n}, k={k}, c={c})")
+                fired = [m for m, te in enumerate(res.t_events) if te.size and te[0] == t_new]
+                phase_changed = False
+                for m in fired:
+                    kind, val = actions[m]
+                    if kind == "phase":
+                        k += val
+                        if k >= model.K:
+                            k, n = 0, n + 1
+                        elif k < 0:
+                            k, n = model.K - 1, n - 1
+                        phase_changed = True
+                    else:
+                        c = val
+                if phase_changed and model.lu > 0.0 and not any(actions[m][0] == "contact" for m in fired):
+                    # the error E can jump at a tooth change (a = 0 or 1): re-classify the contact
+                    d_new, dd_new = model.deflection(n, k, t_new, y_new, theta)
+                    if abs(abs(d_new) - model.lu) > 10 * _ETA_D:
+                        c = model.contact_mode(d_new, dd_new)
+            t, y = t_new, y_new
+    if i_out < n_t:
+        raise RuntimeError("internal error: not all output times were filled")
+    return {
+        "time": t_eval,
+        "coordinates": Y[:nd],
+        "velocities": Y[nd:],
+        "mesh_force_N": F_out,
+        "kd": F_out / model.Frated,
+        "nfev": np.array(nfev),
+        "n_segments": np.array(n_segments),
+    }
