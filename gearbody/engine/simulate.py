@@ -127,14 +127,14 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
     mbs.SetPreStepUserFunction(monitor)
     settings = solver_settings(scenario)
     t_solve0 = time.perf_counter()
-    exu.SuppressWarnings(True)  # min-step notices: gearbody checks the steps itself (_collect)
+    exu.config.suppressWarnings = True  # min-step notices: gearbody checks the steps itself (_collect)
     # Python user functions allocate their return lists by design; Exudyn's allocation notice says so.
     exudyn.solver.solverCheckMemoryAllocationsThreshold = 2**62
     try:
         exu.SolveDynamic(mbs, settings, solverType=SOLVER_TYPES[scenario.solver.method], storeSolver=True,
                          showHints=False)
     finally:
-        exu.SuppressWarnings(False)
+        exu.config.suppressWarnings = False
         monitor.close()
     solve_s = time.perf_counter() - t_solve0
     if monitor.failure:

@@ -71,7 +71,8 @@ class _Ctx:
         return _Ctx(self.source, f"{self.path}.{key}" if self.path else key)
 
     def fail(self, value: Any, message: str) -> typing.NoReturn:
-        raise ScenarioError(f"{self.source}: {self.path} = {value!r}: {message}")
+        shown = f"{value:.6g}" if isinstance(value, float) else repr(value)
+        raise ScenarioError(f"{self.source}: {self.path} = {shown}: {message}")
 
 
 def _type_name(tp: Any) -> str:

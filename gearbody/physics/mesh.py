@@ -194,7 +194,13 @@ def mesh_phase_series(pinion_angle_rad: np.ndarray, P: np.ndarray):
     return p, i, j
 
 
-def mean_stiffness_N_per_m(P: np.ndarray, samples: int = 4096) -> float:
-    """Mean of k_z(p) over one mesh period (healthy teeth), for linearised modes."""
-    ps = (np.arange(samples) + 0.5) / samples
-    return float(np.mean([stiffness_at_phase(p, P) for p in ps]))
+def mean_stiffness_N_per_m(P: np.ndarray) -> float:
+    """Exact mean of k_z(p) over one mesh period (healthy teeth), for linearised modes."""
+    if P[I_KIND] == PROFILE_CONTACT_RATIO:
+        h2 = 2.0 * P[I_HALF_DOUBLE]  # eps - 1
+        return float(h2 * P[I_KDOUBLE] + (1.0 - h2) * P[I_KSINGLE])
+    z1, z2, n = int(P[I_Z1]), int(P[I_Z2]), int(P[I_NTAB])
+    o = I_HEADER + 2 * z1 + z2
+    ph = np.append(P[o:o + n], P[o] + 1.0)
+    kk = np.append(P[o + n:o + 2 * n], P[o + n])
+    return float(np.sum(0.5 * (kk[1:] + kk[:-1]) * np.diff(ph)))

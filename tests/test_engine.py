@@ -1,0 +1,72 @@
+"""The Exudyn engine: steady running, reproducibility, the Result and its file, failures reported."""
+
+import numpy as np
+import pytest
+
+import gearbody as gb
+from gearbody.engine import SimulationError, simulate
+from gearbody.model import load_scenario
+
+STEADY = ['operation.initial_state="steady"', "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
+          "operation.load_profile={time_s=[0.0],fraction=[1.0]}"]
+
+
+def steady(scene, *extra, t_end=0.05):
+    return load_scenario(scene, [*STEADY, f"operation.t_end_s={t_end}", *extra])
+
+
+@pytest.mark.parametrize("scene", ["muller", "two-wheel", "one-stage"])
+def test_static_equilibrium_holds_without_excitation(scene):
+    """Constant stiffness, no error, no friction, steady start: the mesh force stays at F_rated."""
+    sc = steady(scene, "design.mesh.stiffness_double_N_per_m=1.2e9", "production.error_mode.e_um=0",
+                "condition.friction_coefficient=0")
+    r = simulate(sc)
+    assert np.max(np.abs(r.kd - 1.0)) < 2e-3
+
+
+def test_steady_running_transmits_rated_force_on_average():
+    sc = steady("one-stage", t_end=0.2)
+    r = simulate(sc)
+    f_mesh = np.mean(r["mesh_frequency_hz"])
+    n_periods = int((r.time_s[-1] - 0.1) * f_mesh)
+    w = (r.time_s >= r.time_s[-1] - n_periods / f_mesh)
+    assert np.mean(r.kd[w]) == pytest.approx(1.0, abs=0.01)
+    assert f_mesh == pytest.approx(29 * 107.0 / (2 * np.pi), rel=2e-3)  # the seed's rated speed
+
+
+def test_result_has_fixed_output_grid_signals_and_metadata(tmp_path):
+    sc = steady("one-stage")
+    r = gb.simulate(sc)
+    rate = sc.solver.output_rate_hz
+    assert np.allclose(np.diff(r.time_s), 1 / rate)
+    assert r.time_s[-1] == pytest.approx(0.05)
+    for name in ("mesh_force_N", "kd", "pinion_angle_rad", "pinion_speed_rad_s", "pinion_accel_rad_s2",
+                 "wheel_angle_rad", "motor_speed_rad_s", "machine_speed_rad_s", "friction_force_N"):
+        assert r[name].shape == r.time_s.shape and np.all(np.isfinite(r[name]))
+    assert np.allclose(r.kd, r.mesh_force / sc.rated_mesh_force_N)
+    for key in ("scenario", "seed", "gearbody_version", "exudyn_version", "solver_statistics", "output_rate_hz"):
+        assert key in r.meta
+    assert r.meta["solver_statistics"]["steps"] > 0
+    back = gb.Result.load_npz(r.save_npz(tmp_path / "result.npz"))
+    assert np.array_equal(back.mesh_force, r.mesh_force) and back.meta["seed"] == sc.meta.seed
+    with np.load(tmp_path / "result.npz") as z:
+        assert {"time", "mesh_force_N"} <= set(z.files)
+
+
+def test_same_seed_same_run_other_seed_other_teeth():
+    a = simulate(steady("two-wheel", "production.error_mode.r=0.8"))
+    b = simulate(steady("two-wheel", "production.error_mode.r=0.8"))
+    c = simulate(steady("two-wheel", "production.error_mode.r=0.8", "meta.seed=2"))
+    assert np.array_equal(a.mesh_force, b.mesh_force)
+    assert not np.allclose(a.mesh_force, c.mesh_force)
+
+
+def test_muller_pitch_line_is_kinematic():
+    """Muller: the mesh phase follows the prescribed speed, whatever the mass does."""
+    r = simulate(steady("muller"))
+    assert np.allclose(r["pinion_angle_rad"], r.time_s * 108.63)
+
+
+def test_motor_that_cannot_carry_the_load_is_reported_before_running():
+    with pytest.raises(SimulationError, match="breakdown torque"):
+        simulate(steady("one-stage", "design.machine.rated_torque_Nm=6000"))
