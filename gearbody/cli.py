@@ -21,34 +21,60 @@ EPILOG = """examples:
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
-        prog="gearbody", description="Gearbox vibration simulation for diagnostics (Exudyn multibody engine).",
-        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+        prog="gearbody",
+        description="Gearbox vibration simulation for diagnostics (Exudyn multibody engine).",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     sub.add_parser("list", help="list the shipped scenes, one per line (name first, then its title)")
 
-    run = sub.add_parser("run", help="simulate a scene or scenario file and write results and plots",
-                         formatter_class=argparse.RawDescriptionHelpFormatter, description=(
-                             "Simulate SCENE and write DIR/result.npz (named arrays: time, mesh_force_N, kd, "
-                             "angles, speeds, accelerations, ...), DIR/scenario.toml (fully resolved, re-runnable "
-                             "with 'gearbody run DIR/scenario.toml'), DIR/summary.json and PNG plots (K_d over "
-                             "time, K_d folded over the mesh period, spectrum of the pinion acceleration)."))
-    run.add_argument("scene", metavar="SCENE", help="scene name (see 'gearbody list') or path to a .toml scenario")
-    run.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                     help="override a scenario value by its dotted key, e.g. production.error_mode.e_um=15 "
-                          "(repeatable; values are TOML: numbers, true/false, [arrays], \"strings\")")
+    run = sub.add_parser(
+        "run",
+        help="simulate a scene or scenario file and write results and plots",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description=(
+            "Simulate SCENE and write DIR/result.npz (named arrays: time, mesh_force_N, kd, "
+            "angles, speeds, accelerations, ...), DIR/scenario.toml (fully resolved, re-runnable "
+            "with 'gearbody run DIR/scenario.toml'), DIR/summary.json and PNG plots (K_d over "
+            "time, K_d folded over the mesh period, spectrum of the pinion acceleration)."
+        ),
+    )
+    run.add_argument(
+        "scene", metavar="SCENE", help="scene name (see 'gearbody list') or path to a .toml scenario"
+    )
+    run.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a scenario value by its dotted key, e.g. production.error_mode.e_um=15 "
+        '(repeatable; values are TOML: numbers, true/false, [arrays], "strings")',
+    )
     run.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time (sets operation.t_end_s)")
     run.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: runs/SCENE)")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument("--quiet", action="store_true", help="no progress display and no summary on screen")
 
-    modes = sub.add_parser("modes", help="natural frequencies (Hz) at mean mesh stiffness, and resonance speeds")
+    modes = sub.add_parser(
+        "modes", help="natural frequencies (Hz) at mean mesh stiffness, and resonance speeds"
+    )
     modes.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
-    modes.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                       help="override a scenario value (as for run)")
+    modes.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a scenario value (as for run)",
+    )
     modes.add_argument("--harmonics", type=int, default=3, help="mesh harmonics to list resonance speeds for")
 
-    val = sub.add_parser("validate", help="compare gearbody with the independent ODE reference (exit 1 above tolerance)")
+    val = sub.add_parser(
+        "validate", help="compare gearbody with the independent ODE reference (exit 1 above tolerance)"
+    )
     val.add_argument("scenes", metavar="SCENE", nargs="*", help="scenes to validate (default: all)")
     val.add_argument("--short", action="store_true", help="short runs (as in the test suite)")
     val.add_argument("--tolerance", type=float, default=0.5, help="max |dF|/F_rated in %% (default 0.5)")
@@ -91,11 +117,22 @@ def cmd_run(args) -> int:
     plots = [] if args.no_plots else write_plots(result, out)
     if not args.quiet:
         print(f"{scenario.meta.title}")
-        for key in ("kd_max", "kd_max_final", "kd_mean_final", "separation_fraction", "mesh_frequency_hz",
-                    "mean_speed_rad_s", "simulated_time_s", "wall_time_s"):
+        for key in (
+            "kd_max",
+            "kd_max_final",
+            "kd_mean_final",
+            "separation_fraction",
+            "mesh_frequency_hz",
+            "mean_speed_rad_s",
+            "simulated_time_s",
+            "wall_time_s",
+        ):
             v = summary[key]
             print(f"  {key:22s} {v:.4g}" if isinstance(v, float) else f"  {key:22s} {v}")
-        print(f"wrote {out}/result.npz, scenario.toml, summary.json" + (f", {len(plots)} plots" if plots else ""))
+        print(
+            f"wrote {out}/result.npz, scenario.toml, summary.json"
+            + (f", {len(plots)} plots" if plots else "")
+        )
     return 0
 
 

@@ -39,8 +39,11 @@ def summarize(result: Result) -> dict[str, Any]:
     """Summary values of a run (see module docstring for the windows)."""
     win = final_window(result)
     sep = separation_stats(result.mesh_force, result.time_s, kd=result.kd)
-    speed = (result["pinion_speed_rad_s"] if "pinion_speed_rad_s" in result
-             else 2 * math.pi * result["mesh_frequency_hz"] / result.meta["pinion_teeth"])
+    speed = (
+        result["pinion_speed_rad_s"]
+        if "pinion_speed_rad_s" in result
+        else 2 * math.pi * result["mesh_frequency_hz"] / result.meta["pinion_teeth"]
+    )
     stats = result.meta.get("solver_statistics", {})
     return {
         "scene": result.meta.get("scene"),
@@ -68,19 +71,40 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
     """K_d over time, K_d folded over the mesh period (final window), spectrum of the acceleration."""
     out = Path(out_dir)
     title = result.meta.get("title", result.meta.get("scene", ""))
-    paths = [plots.plot_kd_time(result.time_s, result.kd, out / "kd_time.png", title=f"{title}: K_d = F(t)/F_rated")]
+    paths = [
+        plots.plot_kd_time(
+            result.time_s, result.kd, out / "kd_time.png", title=f"{title}: K_d = F(t)/F_rated"
+        )
+    ]
     win = final_window(result)
-    folded = fold_over_mesh_period(result.kd[win], pinion_angle(result)[win], int(result.meta["pinion_teeth"]))
-    paths.append(plots.plot_kd_folded(folded, out / "kd_folded.png",
-                                      title=f"{title}: K_d over the mesh period (last {FINAL_FRACTION:.0%} of run)"))
+    f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
+    # at most one bin per sample of a mesh period, so that every bin is filled
+    bins = int(np.clip(result.sample_rate_hz / max(f_mesh, 1e-9), 10, 100))
+    folded = fold_over_mesh_period(
+        result.kd[win], pinion_angle(result)[win], int(result.meta["pinion_teeth"]), bins=bins
+    )
+    paths.append(
+        plots.plot_kd_folded(
+            folded,
+            out / "kd_folded.png",
+            title=f"{title}: K_d over the mesh period (last {FINAL_FRACTION:.0%} of run)",
+        )
+    )
     name, signal = vibration_signal(result)
     spec = amplitude_spectrum(signal[win], result.sample_rate_hz)
-    f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
     z1, z2 = int(result.meta["pinion_teeth"]), int(result.meta["wheel_teeth"])
     shafts = {"f_1": f_mesh / z1, "f_2": f_mesh / z2} if f_mesh > 0 else {}
     unit = "rad/s²" if name.endswith("rad_s2") else "m/s²"
-    paths.append(plots.plot_spectrum(spec, out / "spectrum.png", mesh_frequency_hz=f_mesh if f_mesh > 0 else None,
-                                     shaft_frequencies_hz=shafts, title=f"{title}: spectrum of {name}",
-                                     fmax_hz=min(result.sample_rate_hz / 2, 8 * f_mesh if f_mesh > 0 else 1e9),
-                                     ylabel=f"amplitude [{unit}]", log_amplitude=True))
+    paths.append(
+        plots.plot_spectrum(
+            spec,
+            out / "spectrum.png",
+            mesh_frequency_hz=f_mesh if f_mesh > 0 else None,
+            shaft_frequencies_hz=shafts,
+            title=f"{title}: spectrum of {name}",
+            fmax_hz=min(result.sample_rate_hz / 2, 8 * f_mesh if f_mesh > 0 else 1e9),
+            ylabel=f"amplitude [{unit}]",
+            log_amplitude=True,
+        )
+    )
     return paths

@@ -1,4 +1,6 @@
-"""The scenes shipped with gearbody: one TOML scenario per system of the paper (installed as gearbody.scenes)."""
+"""The scenes shipped with gearbody: one TOML scenario per system of the paper.
+
+Installed as ``gearbody.scenes``."""
 
 from __future__ import annotations
 
@@ -22,6 +24,8 @@ def scene_path(name: str) -> Path:
 
         near = difflib.get_close_matches(name, list_scenes(), n=1)
         hint = f"; did you mean {near[0]!r}?" if near else ""
-        raise ScenarioError(f"unknown scene {name!r}{hint} (scenes: {', '.join(list_scenes())}; "
-                            "or give a path to a .toml file)")
+        raise ScenarioError(
+            f"unknown scene {name!r}{hint} (scenes: {', '.join(list_scenes())}; "
+            "or give a path to a .toml file)"
+        )
     return path

@@ -7,8 +7,11 @@ import gearbody as gb
 from gearbody.engine import SimulationError, simulate
 from gearbody.model import load_scenario
 
-STEADY = ['operation.initial_state="steady"', "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
-          "operation.load_profile={time_s=[0.0],fraction=[1.0]}"]
+STEADY = [
+    'operation.initial_state="steady"',
+    "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
+    "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
+]
 
 
 def steady(scene, *extra, t_end=0.05):
@@ -18,8 +21,12 @@ def steady(scene, *extra, t_end=0.05):
 @pytest.mark.parametrize("scene", ["muller", "two-wheel", "one-stage"])
 def test_static_equilibrium_holds_without_excitation(scene):
     """Constant stiffness, no error, no friction, steady start: the mesh force stays at F_rated."""
-    sc = steady(scene, "design.mesh.stiffness_double_N_per_m=1.2e9", "production.error_mode.e_um=0",
-                "condition.friction_coefficient=0")
+    sc = steady(
+        scene,
+        "design.mesh.stiffness_double_N_per_m=1.2e9",
+        "production.error_mode.e_um=0",
+        "condition.friction_coefficient=0",
+    )
     r = simulate(sc)
     assert np.max(np.abs(r.kd - 1.0)) < 2e-3
 
@@ -29,7 +36,7 @@ def test_steady_running_transmits_rated_force_on_average():
     r = simulate(sc)
     f_mesh = np.mean(r["mesh_frequency_hz"])
     n_periods = int((r.time_s[-1] - 0.1) * f_mesh)
-    w = (r.time_s >= r.time_s[-1] - n_periods / f_mesh)
+    w = r.time_s >= r.time_s[-1] - n_periods / f_mesh
     assert np.mean(r.kd[w]) == pytest.approx(1.0, abs=0.01)
     assert f_mesh == pytest.approx(29 * 107.0 / (2 * np.pi), rel=2e-3)  # the seed's rated speed
 
@@ -40,11 +47,27 @@ def test_result_has_fixed_output_grid_signals_and_metadata(tmp_path):
     rate = sc.solver.output_rate_hz
     assert np.allclose(np.diff(r.time_s), 1 / rate)
     assert r.time_s[-1] == pytest.approx(0.05)
-    for name in ("mesh_force_N", "kd", "pinion_angle_rad", "pinion_speed_rad_s", "pinion_accel_rad_s2",
-                 "wheel_angle_rad", "motor_speed_rad_s", "machine_speed_rad_s", "friction_force_N"):
+    for name in (
+        "mesh_force_N",
+        "kd",
+        "pinion_angle_rad",
+        "pinion_speed_rad_s",
+        "pinion_accel_rad_s2",
+        "wheel_angle_rad",
+        "motor_speed_rad_s",
+        "machine_speed_rad_s",
+        "friction_force_N",
+    ):
         assert r[name].shape == r.time_s.shape and np.all(np.isfinite(r[name]))
     assert np.allclose(r.kd, r.mesh_force / sc.rated_mesh_force_N)
-    for key in ("scenario", "seed", "gearbody_version", "exudyn_version", "solver_statistics", "output_rate_hz"):
+    for key in (
+        "scenario",
+        "seed",
+        "gearbody_version",
+        "exudyn_version",
+        "solver_statistics",
+        "output_rate_hz",
+    ):
         assert key in r.meta
     assert r.meta["solver_statistics"]["steps"] > 0
     back = gb.Result.load_npz(r.save_npz(tmp_path / "result.npz"))

@@ -23,10 +23,22 @@ K1, K2, EPS = 1.0e9, 1.5e9, 1.6  # single, double contact; h = 0.3
 
 
 def params(**kw):
-    base = dict(r1_m=R1, r2_m=R2, z1=Z1, z2=Z2, stiffness_single_N_per_m=K1, stiffness_double_N_per_m=K2,
-                contact_ratio=EPS, damping_Ns_per_m=0.0, backlash_m=0.0, friction_coefficient=0.0,
-                pitch_point_phase=0.5, pressure_angle_rad=math.radians(20), error_a=0.5,
-                error_depths_m=np.zeros(Z1))
+    base = dict(
+        r1_m=R1,
+        r2_m=R2,
+        z1=Z1,
+        z2=Z2,
+        stiffness_single_N_per_m=K1,
+        stiffness_double_N_per_m=K2,
+        contact_ratio=EPS,
+        damping_Ns_per_m=0.0,
+        backlash_m=0.0,
+        friction_coefficient=0.0,
+        pitch_point_phase=0.5,
+        pressure_angle_rad=math.radians(20),
+        error_a=0.5,
+        error_depths_m=np.zeros(Z1),
+    )
     base.update(kw)
     return pack_mesh_parameters(**base)
 
@@ -83,10 +95,10 @@ def test_error_peaks_at_position_a_with_per_tooth_depth():
 
 
 def test_random_tooth_errors_follow_eq6_and_are_reproducible_from_the_seed():
-    l = np.random.default_rng(3).random(Z1)
-    assert np.array_equal(tooth_random_factors(Z1, 3), l)
+    li = np.random.default_rng(3).random(Z1)
+    assert np.array_equal(tooth_random_factors(Z1, 3), li)
     e = tooth_error_depths_m(12.0, 0.3, Z1, seed=3)
-    assert np.allclose(e, (1 - 0.3 * (1 - l)) * 12e-6)
+    assert np.allclose(e, (1 - 0.3 * (1 - li)) * 12e-6)
     assert np.array_equal(e, tooth_error_depths_m(12.0, 0.3, Z1, seed=3))
     assert not np.array_equal(e, tooth_error_depths_m(12.0, 0.3, Z1, seed=4))
     assert np.allclose(tooth_error_depths_m(12.0, 0.0, Z1, seed=3), 12e-6)  # r = 0: no scatter
@@ -117,7 +129,7 @@ def test_friction_reverses_at_the_pitch_point_and_dissipates():
     pb = 2 * math.pi * R1 / Z1
     for p, sign in ((0.4, 1.0), (0.6, -1.0)):
         F, T, rho1, rho2 = mesh_contact(angle_at(2, p), d, 0.0, P)
-        assert T == pytest.approx(sign * mu * F)
+        assert T == pytest.approx(sign * mu * abs(F))
         assert rho1 == pytest.approx(R1 * math.tan(alpha) + (p - 0.5) * pb)
         assert rho2 == pytest.approx(R2 * math.tan(alpha) - (p - 0.5) * pb)
         # rolling: w1 r1 = w2 r2; friction power T (rho1 w1 - rho2 w2) must be <= 0
@@ -166,3 +178,13 @@ def test_profiles_are_piecewise_linear_and_integrate_exactly():
     tt = np.array([0.5, 1.0])
     ff = np.array([2.0, 0.0])  # held at 2 before 0.5
     assert profile_integral(0.75, tt, ff) == pytest.approx(1.0 + 0.25 * (2.0 + 1.0) / 2)
+
+
+def test_friction_dissipates_on_the_back_flank_too():
+    P = params(friction_coefficient=0.1)
+    for p in (0.3, 0.7):
+        phi = angle_at(1, p)
+        F, T, rho1, rho2 = mesh_contact(phi, -1e-5, 0.0, P)  # back-flank contact: F < 0
+        assert F < 0
+        w1 = 50.0
+        assert T * (rho1 * w1 - rho2 * w1 * R1 / R2) < 0

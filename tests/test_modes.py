@@ -13,8 +13,11 @@ from gearbody.physics import mean_stiffness_N_per_m, mesh_parameters_from_scenar
 
 
 def chain(J, springs, meshes=()):
-    return TorsionalLayout(tuple(Inertia(f"b{i}", j) for i, j in enumerate(J)),
-                           tuple(ShaftLink(i, j, k) for i, j, k in springs), tuple(meshes))
+    return TorsionalLayout(
+        tuple(Inertia(f"b{i}", j) for i, j in enumerate(J)),
+        tuple(ShaftLink(i, j, k) for i, j, k in springs),
+        tuple(meshes),
+    )
 
 
 def eigh_hz(M, K):
@@ -49,22 +52,32 @@ def test_scene_modes_equal_eigh_on_hand_built_matrices():
     d = sc.design
     k = mean_stiffness_N_per_m(mesh_parameters_from_scenario(sc))
     eps = d.mesh.contact_ratio
-    assert k == pytest.approx((eps - 1) * d.mesh.stiffness_double_N_per_m + (2 - eps) * d.mesh.stiffness_single_N_per_m)
+    assert k == pytest.approx(
+        (eps - 1) * d.mesh.stiffness_double_N_per_m + (2 - eps) * d.mesh.stiffness_single_N_per_m
+    )
     r1, r2 = d.pinion.base_radius_m, d.wheel.base_radius_m
     k1, k2 = d.coupling.stiffness_Nm_per_rad, d.output_shaft.stiffness_Nm_per_rad
-    M = np.diag([d.motor.inertia_kg_m2, d.pinion.inertia_kg_m2, d.wheel.inertia_kg_m2, d.machine.inertia_kg_m2])
-    K = np.array([[k1, -k1, 0, 0],
-                  [-k1, k1 + k * r1 ** 2, -k * r1 * r2, 0],
-                  [0, -k * r1 * r2, k2 + k * r2 ** 2, -k2],
-                  [0, 0, -k2, k2]])
+    M = np.diag(
+        [d.motor.inertia_kg_m2, d.pinion.inertia_kg_m2, d.wheel.inertia_kg_m2, d.machine.inertia_kg_m2]
+    )
+    K = np.array(
+        [
+            [k1, -k1, 0, 0],
+            [-k1, k1 + k * r1**2, -k * r1 * r2, 0],
+            [0, -k * r1 * r2, k2 + k * r2**2, -k2],
+            [0, 0, -k2, k2],
+        ]
+    )
     expected = eigh_hz(M, K)
     got = scene_modes(sc).frequencies_hz
     assert got[1:] == pytest.approx(expected[1:], rel=1e-6)
     assert got[0] == pytest.approx(0.0, abs=1e-3)
     # two-wheel: rigid shafts, motor and machine lumped with the gears
     sc2 = load_scenario("two-wheel")
-    M2 = np.diag([d.motor.inertia_kg_m2 + d.pinion.inertia_kg_m2, d.wheel.inertia_kg_m2 + d.machine.inertia_kg_m2])
-    K2 = k * np.array([[r1 ** 2, -r1 * r2], [-r1 * r2, r2 ** 2]])
+    M2 = np.diag(
+        [d.motor.inertia_kg_m2 + d.pinion.inertia_kg_m2, d.wheel.inertia_kg_m2 + d.machine.inertia_kg_m2]
+    )
+    K2 = k * np.array([[r1**2, -r1 * r2], [-r1 * r2, r2**2]])
     assert scene_modes(sc2).frequencies_hz[1] == pytest.approx(eigh_hz(M2, K2)[1], rel=1e-6)
     # Muller: one reduced mass on the mean mesh spring
     f_muller = scene_modes(load_scenario("muller")).frequencies_hz[0]

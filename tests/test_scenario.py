@@ -3,9 +3,9 @@
 import re
 
 import pytest
+from gearbody.scenes import list_scenes, scene_path
 
 from gearbody.model import ScenarioError, dump_scenario, load_scenario, parse_override, scenario_to_dict
-from gearbody.scenes import list_scenes, scene_path
 
 
 def refused(scene: str, *overrides: str) -> str:
@@ -28,21 +28,24 @@ def test_python_dict_builds_the_same_scenario_as_the_file():
     assert load_scenario(scenario_to_dict(sc)) == sc
 
 
-@pytest.mark.parametrize(("override", "key", "range_text"), [
-    ("design.pinion.inertia_kg_m2=0", "design.pinion.inertia_kg_m2", "> 0"),
-    ("design.motor.inertia_kg_m2=-1.0", "design.motor.inertia_kg_m2", "> 0"),
-    ("design.coupling.stiffness_Nm_per_rad=0", "design.coupling.stiffness_Nm_per_rad", "> 0"),
-    ("design.mesh.stiffness_single_N_per_m=-5e8", "design.mesh.stiffness_single_N_per_m", "> 0"),
-    ("design.wheel.base_radius_m=0", "design.wheel.base_radius_m", "> 0"),
-    ("design.pinion.teeth=5", "design.pinion.teeth", ">= 6"),
-    ("production.error_mode.a=1.2", "production.error_mode.a", ">= 0 and <= 1"),
-    ("production.error_mode.r=-0.1", "production.error_mode.r", ">= 0 and <= 1"),
-    ("design.mesh.contact_ratio=0.9", "design.mesh.contact_ratio", ">= 1"),
-    ("design.mesh.backlash_um=-3", "design.mesh.backlash_um", ">= 0"),
-    ("operation.t_end_s=0", "operation.t_end_s", "> 0"),
-    ("operation.t_end_s=-1", "operation.t_end_s", "> 0"),
-    ("condition.friction_coefficient=1.5", "condition.friction_coefficient", ">= 0 and < 1"),
-])
+@pytest.mark.parametrize(
+    ("override", "key", "range_text"),
+    [
+        ("design.pinion.inertia_kg_m2=0", "design.pinion.inertia_kg_m2", "> 0"),
+        ("design.motor.inertia_kg_m2=-1.0", "design.motor.inertia_kg_m2", "> 0"),
+        ("design.coupling.stiffness_Nm_per_rad=0", "design.coupling.stiffness_Nm_per_rad", "> 0"),
+        ("design.mesh.stiffness_single_N_per_m=-5e8", "design.mesh.stiffness_single_N_per_m", "> 0"),
+        ("design.wheel.base_radius_m=0", "design.wheel.base_radius_m", "> 0"),
+        ("design.pinion.teeth=5", "design.pinion.teeth", ">= 6"),
+        ("production.error_mode.a=1.2", "production.error_mode.a", ">= 0 and <= 1"),
+        ("production.error_mode.r=-0.1", "production.error_mode.r", ">= 0 and <= 1"),
+        ("design.mesh.contact_ratio=0.9", "design.mesh.contact_ratio", ">= 1"),
+        ("design.mesh.backlash_um=-3", "design.mesh.backlash_um", ">= 0"),
+        ("operation.t_end_s=0", "operation.t_end_s", "> 0"),
+        ("operation.t_end_s=-1", "operation.t_end_s", "> 0"),
+        ("condition.friction_coefficient=1.5", "condition.friction_coefficient", ">= 0 and < 1"),
+    ],
+)
 def test_non_physical_values_are_refused_naming_file_key_value_and_range(override, key, range_text):
     msg = refused("one-stage", override)
     assert "one-stage.toml" in msg
@@ -84,8 +87,11 @@ def test_missing_required_values_are_refused(tmp_path):
 def test_cross_checks_between_values():
     assert "base pitch" in refused("one-stage", "design.wheel.base_radius_m=0.25")
     assert "must be < its 29 teeth" in refused(
-        "one-stage", 'condition.damaged_teeth=[{gear="pinion",tooth=29,stiffness_factor=0.5}]')
-    assert "strictly increasing" in refused("one-stage", "operation.load_profile={time_s=[1.0,0.5],fraction=[0,1]}")
+        "one-stage", 'condition.damaged_teeth=[{gear="pinion",tooth=29,stiffness_factor=0.5}]'
+    )
+    assert "strictly increasing" in refused(
+        "one-stage", "operation.load_profile={time_s=[1.0,0.5],fraction=[0,1]}"
+    )
     assert "same length" in refused("one-stage", "operation.load_profile={time_s=[0.0,0.5],fraction=[1]}")
     assert "same length" in refused("one-stage", 'design.mesh.stiffness_profile="table"')
 
@@ -94,7 +100,9 @@ def test_syntax_errors_and_missing_files_name_the_file(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text("[meta\nscene = 1")
     assert "bad.toml: not valid TOML" in str(pytest.raises(ScenarioError, load_scenario, bad).value)
-    assert "no such scenario file" in str(pytest.raises(ScenarioError, load_scenario, tmp_path / "x.toml").value)
+    assert "no such scenario file" in str(
+        pytest.raises(ScenarioError, load_scenario, tmp_path / "x.toml").value
+    )
 
 
 def test_overrides_parse_toml_values():

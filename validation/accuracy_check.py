@@ -39,7 +39,8 @@ def compare(sc: dict, rtol: float = 1e-10, factor: float = 10.0) -> dict:
 
 
 def main(argv: list[str]) -> None:
-    paths = [pathlib.Path(p) for p in argv] or sorted((pathlib.Path(__file__).parent / "scenarios").glob("*.toml"))
+    default = sorted((pathlib.Path(__file__).parent / "scenarios").glob("*.toml"))
+    paths = [pathlib.Path(p) for p in argv] or default
     for path in paths:
         r = compare(load_scenario(path))
         print(

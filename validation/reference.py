@@ -41,6 +41,7 @@ except ModuleNotFoundError:  # pragma: no cover
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 __all__ = [
     "load_scenario",
@@ -162,7 +163,8 @@ def base_stiffness(p, mesh: dict):
     if prof == "contact-ratio":
         h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
         double = (p < h) | (p >= 1.0 - h)
-        return np.where(double, float(mesh["stiffness_double_N_per_m"]), float(mesh["stiffness_single_N_per_m"]))
+        k_double = float(mesh["stiffness_double_N_per_m"])
+        return np.where(double, k_double, float(mesh["stiffness_single_N_per_m"]))
     if prof == "table":
         ph = np.asarray(mesh["table_phase"], dtype=float)
         kk = np.asarray(mesh["table_stiffness_N_per_m"], dtype=float)
@@ -224,7 +226,7 @@ def mesh_force_literal(scenario: dict, u, delta, delta_dot) -> dict:
 
 
 def friction_moments(scenario: dict, p, F) -> dict:
-    """T = mu F s and the moments M_zt1 = T rho_1, M_zt2 = T rho_2 (literal)."""
+    """T = mu |F| s and the moments M_zt1 = T rho_1, M_zt2 = T rho_2 (literal)."""
     d_ = scenario["design"]
     mesh = d_["mesh"]
     r1, r2 = float(d_["pinion"]["base_radius_m"]), float(d_["wheel"]["base_radius_m"])
@@ -234,7 +236,7 @@ def friction_moments(scenario: dict, p, F) -> dict:
     pb = TWO_PI * r1 / z1
     p = np.asarray(p, dtype=float)
     s = np.where(p < ppp, 1.0, -1.0)
-    T = float(scenario["condition"]["friction_coefficient"]) * np.asarray(F, dtype=float) * s
+    T = float(scenario["condition"]["friction_coefficient"]) * np.abs(np.asarray(F, dtype=float)) * s
     rho1 = r1 * tan_a + (p - ppp) * pb
     rho2 = r2 * tan_a - (p - ppp) * pb
     return {"T": T, "rho1": rho1, "rho2": rho2, "M_zt1": T * rho1, "M_zt2": T * rho2}
@@ -255,7 +257,8 @@ def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     r1, r2 = float(d_["pinion"]["base_radius_m"]), float(d_["wheel"]["base_radius_m"])
     mesh = d_["mesh"]
     lu = float(mesh["backlash_um"]) * 1e-6
-    M_L = float(d_["machine"]["rated_torque_Nm"]) * float(profile_value(0.0, scenario["operation"]["load_profile"]))
+    load0 = float(profile_value(0.0, scenario["operation"]["load_profile"]))
+    M_L = float(d_["machine"]["rated_torque_Nm"]) * load0
     F0 = M_L / r2
     M_p = F0 * r1
     f, g = tooth_factors(scenario)
@@ -367,10 +370,12 @@ class _Model:
         self.I2 = float(d_["wheel"]["inertia_kg_m2"])
         self.Im = float(d_["machine"]["inertia_kg_m2"])
         self.Mrated = float(d_["machine"]["rated_torque_Nm"])
-        self.k1 = float(d_["coupling"]["stiffness_Nm_per_rad"])
-        self.C1 = float(d_["coupling"]["damping_Nms_per_rad"])
-        self.k2 = float(d_["output_shaft"]["stiffness_Nm_per_rad"])
-        self.C2 = float(d_["output_shaft"]["damping_Nms_per_rad"])
+        # shafts exist only in the one-stage system (two-wheel: rigid shafts, keys absent)
+        coupling, shaft = d_.get("coupling", {}), d_.get("output_shaft", {})
+        self.k1 = float(coupling.get("stiffness_Nm_per_rad", 0.0))
+        self.C1 = float(coupling.get("damping_Nms_per_rad", 0.0))
+        self.k2 = float(shaft.get("stiffness_Nm_per_rad", 0.0))
+        self.C2 = float(shaft.get("damping_Nms_per_rad", 0.0))
         self.m_red = reduced_mass(sc)
         op = sc["operation"]
         self.speed_prof = op["speed_profile"]
@@ -466,12 +471,14 @@ class _Model:
                 tau = t - ta
                 p = p1 * cz - nf
                 F = mesh(mc, p, r1 * p1 - r2 * p2, r1 * w1 - r2 * w2)
-                T = mus * F
+                T = mus * abs(F)
                 q = (p - ppp) * pb
                 slip = (wsr * (sa + ss * tau) - w1) / wsr
                 Ms = 2.0 * Mb * sb * slip / (slip * slip + sbsq)
                 Mr = Mrated * (la + ls * tau)
-                return array([w1, w2, (Ms - r1 * F + T * (r1tan + q)) / J1, (r2 * F - T * (r2tan - q) - Mr) / J2])
+                return array(
+                    [w1, w2, (Ms - r1 * F + T * (r1tan + q)) / J1, (r2 * F - T * (r2tan - q) - Mr) / J2]
+                )
 
             return rhs, mc
 
@@ -483,7 +490,7 @@ class _Model:
             tau = t - ta
             p = p2 * cz - nf
             F = mesh(mc, p, r1 * p2 - r2 * p3, r1 * w2 - r2 * w3)
-            T = mus * F
+            T = mus * abs(F)
             q = (p - ppp) * pb
             slip = (wsr * (sa + ss * tau) - w1) / wsr
             Ms = 2.0 * Mb * sb * slip / (slip * slip + sbsq)
@@ -580,6 +587,51 @@ def _chunk(model: _Model, ta: float, tb: float, theta_a: float) -> dict:
     return {"ta": ta, "tb": tb, "sa": sa, "ss": ss, "la": la, "ls": ls, "theta_a": theta_a, "ws": ws}
 
 
+def _scan_missed_events(sol, events: list, t0: float, t1: float, n_sub: int = 16):
+    """Look for mode boundaries crossed *inside* a step (crossed and re-crossed, or crossed before
+    a step end at which solve_ivp saw no sign change).  solve_ivp only compares the event functions
+    at step ends, which misses e.g. a short dip of the deflection into the backlash.  The dense
+    output of every step is sampled at n_sub points; the earliest crossing is located with brentq.
+
+    Returns (event index, root time) or None.
+    """
+    ts = np.asarray(sol.ts)
+    if ts.size < 2:
+        return None
+    frac = np.arange(1, n_sub) / n_sub
+    tt = (ts[:-1, None] + np.diff(ts)[:, None] * frac[None, :]).ravel()
+    tt = tt[(tt > t0) & (tt < t1)]
+    if tt.size == 0:
+        return None
+    yy = sol(tt)
+    first = {}
+    for m, ev in enumerate(events):
+        g = np.asarray(ev(tt, yy))
+        bad = g > 0.0 if ev.direction > 0 else g < 0.0
+        if bad.any():
+            first[m] = int(np.argmax(bad))
+    if not first:
+        return None
+    q = min(first.values())
+    t_lo = tt[q - 1] if q > 0 else t0
+    best = None
+    for m, qm in first.items():
+        if qm != q:
+            continue
+        ev = events[m]
+
+        def gfun(s, ev=ev):
+            return float(ev(s, sol(s)))
+
+        g_lo = gfun(t_lo)
+        ok_lo = g_lo <= 0.0 if ev.direction > 0 else g_lo >= 0.0
+        eps4 = 4 * np.finfo(float).eps
+        root = brentq(gfun, t_lo, tt[q], xtol=eps4, rtol=eps4) if ok_lo else t_lo
+        if best is None or root < best[1]:
+            best = (m, root)
+    return best
+
+
 def simulate_reference(
     scenario: dict,
     t_eval: np.ndarray | None = None,
@@ -591,7 +643,8 @@ def simulate_reference(
     """Integrate a resolved scenario; see the module docstring.
 
     Returns time, coordinates and velocities (n_dof x n_t), mesh_force_N (F = F_el + F_t),
-    kd = F / F_rated and nfev (0-d array).
+    kd = F / F_rated and nfev (0-d array); for diagnostics also n_segments (restarts of
+    solve_ivp) and n_missed_events (mode boundaries found inside a step by the dense scan).
     """
     model = _Model(scenario)
     op = scenario["operation"]
@@ -643,6 +696,7 @@ def simulate_reference(
     h_prev = None
     zero_segments = 0
     n_segments = 0
+    n_missed = 0
 
     def fill_outputs(sol, t_lo, t_hi, mc, include_end):
         nonlocal i_out
@@ -673,8 +727,15 @@ def simulate_reference(
             events, actions = model.make_events(n, k, c, mc, theta)
             first = min(h_prev, tb - t) if h_prev else None
             res = solve_ivp(
-                rhs, (t, tb), y, method=method, rtol=rtol, atol=atol,
-                events=events, dense_output=True, first_step=first,
+                rhs,
+                (t, tb),
+                y,
+                method=method,
+                rtol=rtol,
+                atol=atol,
+                events=events,
+                dense_output=True,
+                first_step=first,
             )
             if res.status < 0:
                 raise RuntimeError(f"solve_ivp failed at t={t}: {res.message}")
@@ -682,17 +743,25 @@ def simulate_reference(
             n_segments += 1
             t_new = float(res.t[-1])
             y_new = res.y[:, -1].copy()
+            fired = []
+            if res.status == 1:
+                fired = [m for m, te in enumerate(res.t_events) if te.size and te[0] == t_new]
+            missed = _scan_missed_events(res.sol, events, t, t_new)
+            if missed is not None:
+                fired = [missed[0]]
+                t_new = float(missed[1])
+                y_new = res.sol(t_new)
+                n_missed += 1
             ts_steps = res.sol.ts
             if ts_steps.size >= 3:
                 h_prev = float(ts_steps[-2] - ts_steps[-3])
             elif ts_steps.size == 2 and res.status == 0:
                 h_prev = float(ts_steps[-1] - ts_steps[-2])
-            fill_outputs(res.sol, t, t_new, mc, last_chunk and res.status == 0)
-            if res.status == 1:
+            fill_outputs(res.sol, t, t_new, mc, last_chunk and not fired)
+            if fired:
                 zero_segments = zero_segments + 1 if t_new == t else 0
                 if zero_segments > _MAX_ZERO_SEGMENTS:
                     raise RuntimeError(f"mode chattering at t={t_new} (n={n}, k={k}, c={c})")
-                fired = [m for m, te in enumerate(res.t_events) if te.size and te[0] == t_new]
                 phase_changed = False
                 for m in fired:
                     kind, val = actions[m]
@@ -721,4 +790,5 @@ def simulate_reference(
         "kd": F_out / model.Frated,
         "nfev": np.array(nfev),
         "n_segments": np.array(n_segments),
+        "n_missed_events": np.array(n_missed),
     }

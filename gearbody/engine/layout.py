@@ -64,14 +64,24 @@ def torsional_layout(scenario: Scenario) -> TorsionalLayout:
     drive = pack_drive_parameters(scenario)
     r1, r2 = d.pinion.base_radius_m, d.wheel.base_radius_m
     if scenario.meta.scene == "one-stage":
-        inertias = (Inertia("motor", d.motor.inertia_kg_m2), Inertia("pinion", d.pinion.inertia_kg_m2),
-                    Inertia("wheel", d.wheel.inertia_kg_m2), Inertia("machine", d.machine.inertia_kg_m2))
-        shafts = (ShaftLink(0, 1, d.coupling.stiffness_Nm_per_rad, d.coupling.damping_Nms_per_rad),
-                  ShaftLink(2, 3, d.output_shaft.stiffness_Nm_per_rad, d.output_shaft.damping_Nms_per_rad))
-        return TorsionalLayout(inertias, shafts, (MeshLink(1, 2, r1, r2, P),), motor_at=0, load_at=3, drive=drive)
+        inertias = (
+            Inertia("motor", d.motor.inertia_kg_m2),
+            Inertia("pinion", d.pinion.inertia_kg_m2),
+            Inertia("wheel", d.wheel.inertia_kg_m2),
+            Inertia("machine", d.machine.inertia_kg_m2),
+        )
+        shafts = (
+            ShaftLink(0, 1, d.coupling.stiffness_Nm_per_rad, d.coupling.damping_Nms_per_rad),
+            ShaftLink(2, 3, d.output_shaft.stiffness_Nm_per_rad, d.output_shaft.damping_Nms_per_rad),
+        )
+        return TorsionalLayout(
+            inertias, shafts, (MeshLink(1, 2, r1, r2, P),), motor_at=0, load_at=3, drive=drive
+        )
     if scenario.meta.scene == "two-wheel":
-        inertias = (Inertia("pinion", d.motor.inertia_kg_m2 + d.pinion.inertia_kg_m2),
-                    Inertia("wheel", d.wheel.inertia_kg_m2 + d.machine.inertia_kg_m2))
+        inertias = (
+            Inertia("pinion", d.motor.inertia_kg_m2 + d.pinion.inertia_kg_m2),
+            Inertia("wheel", d.wheel.inertia_kg_m2 + d.machine.inertia_kg_m2),
+        )
         return TorsionalLayout(inertias, (), (MeshLink(0, 1, r1, r2, P),), motor_at=0, load_at=1, drive=drive)
     raise ValueError(f"scene {scenario.meta.scene!r} has no torsional layout")
 
@@ -79,8 +89,9 @@ def torsional_layout(scenario: Scenario) -> TorsionalLayout:
 def reduced_mass_kg(scenario: Scenario) -> float:
     """Muller's reduced mass along the line of action, m = 1 / (r1^2/I_1p + r2^2/I_2p)."""
     d = scenario.design
-    return 1.0 / (d.pinion.base_radius_m ** 2 / d.pinion.inertia_kg_m2
-                  + d.wheel.base_radius_m ** 2 / d.wheel.inertia_kg_m2)
+    return 1.0 / (
+        d.pinion.base_radius_m**2 / d.pinion.inertia_kg_m2 + d.wheel.base_radius_m**2 / d.wheel.inertia_kg_m2
+    )
 
 
 def steady_operating_point(scenario: Scenario) -> dict[str, float]:
@@ -102,8 +113,14 @@ def steady_operating_point(scenario: Scenario) -> dict[str, float]:
         lu = d.mesh.backlash_um * 1e-6
         k0 = mesh_contact(0.0, lu + 1e-9, 0.0, P)[0] / 1e-9
     delta0 = F0 / k0 + d.mesh.backlash_um * 1e-6 if F0 > 0 else 0.0
-    return {"load_torque_Nm": load, "mesh_force_N": F0, "pinion_torque_Nm": pinion_torque,
-            "pinion_speed_rad_s": w, "wheel_speed_rad_s": w * r1 / r2, "deflection_m": delta0}
+    return {
+        "load_torque_Nm": load,
+        "mesh_force_N": F0,
+        "pinion_torque_Nm": pinion_torque,
+        "pinion_speed_rad_s": w,
+        "wheel_speed_rad_s": w * r1 / r2,
+        "deflection_m": delta0,
+    }
 
 
 def initial_state(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
@@ -113,16 +130,26 @@ def initial_state(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     if scenario.operation.initial_state == "rest":
         return np.zeros(ndof), np.zeros(ndof)
     op = steady_operating_point(scenario)
-    r2, w_p, w_w, delta0 = (scenario.design.wheel.base_radius_m, op["pinion_speed_rad_s"],
-                            op["wheel_speed_rad_s"], op["deflection_m"])
+    r2, w_p, w_w, delta0 = (
+        scenario.design.wheel.base_radius_m,
+        op["pinion_speed_rad_s"],
+        op["wheel_speed_rad_s"],
+        op["deflection_m"],
+    )
     if scene == "muller":
         return np.array([delta0]), np.zeros(1)
     if scene == "two-wheel":
         return np.array([0.0, -delta0 / r2]), np.array([w_p, w_w])
     d = scenario.design
     phi3 = -delta0 / r2
-    q = np.array([op["pinion_torque_Nm"] / d.coupling.stiffness_Nm_per_rad, 0.0, phi3,
-                  phi3 - op["load_torque_Nm"] / d.output_shaft.stiffness_Nm_per_rad])
+    q = np.array(
+        [
+            op["pinion_torque_Nm"] / d.coupling.stiffness_Nm_per_rad,
+            0.0,
+            phi3,
+            phi3 - op["load_torque_Nm"] / d.output_shaft.stiffness_Nm_per_rad,
+        ]
+    )
     return q, np.array([w_p, w_p, w_w, w_w])
 
 

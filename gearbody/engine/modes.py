@@ -33,8 +33,9 @@ class ModeSet:
 
 
 def _eigen(mbs: exu.MainSystem) -> tuple[np.ndarray, np.ndarray]:
-    values, vectors = mbs.ComputeODE2Eigenvalues(useSparseSolver=False, convert2Frequencies=False,
-                                                 useAbsoluteValues=True)
+    values, vectors = mbs.ComputeODE2Eigenvalues(
+        useSparseSolver=False, convert2Frequencies=False, useAbsoluteValues=True
+    )
     values = np.abs(np.asarray(values))
     order = np.argsort(values)
     freqs = np.sqrt(values[order]) / (2 * math.pi)
@@ -58,8 +59,11 @@ def scene_modes(scenario: Scenario) -> ModeSet:
         mbs = SC.AddSystem()
         n = mbs.AddNode(Node1D(referenceCoordinates=[0.0]))
         mbs.AddObject(ObjectMass1D(nodeNumber=n, mass=reduced_mass_kg(scenario)))
-        mbs.AddObject(ObjectGenericODE2(nodeNumbers=[n], massMatrix=np.zeros((1, 1)),
-                                        stiffnessMatrix=np.array([[k_mean]])))
+        mbs.AddObject(
+            ObjectGenericODE2(
+                nodeNumbers=[n], massMatrix=np.zeros((1, 1)), stiffnessMatrix=np.array([[k_mean]])
+            )
+        )
         mbs.Assemble()
         freqs, shapes = _eigen(mbs)
         return ModeSet(freqs, shapes, ["deflection"], k_mean)

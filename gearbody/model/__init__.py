@@ -22,7 +22,25 @@ from .scenario import (
 )
 
 __all__ = [
-    "SCENES", "Condition", "DamagedTooth", "Design", "ErrorMode", "Gear", "Machine", "Mesh", "Meta", "Motor",
-    "Operation", "Production", "Profile", "Scenario", "ScenarioError", "Shaft", "Solver", "dump_scenario",
-    "load_scenario", "parse_override", "scenario_to_dict",
+    "SCENES",
+    "Condition",
+    "DamagedTooth",
+    "Design",
+    "ErrorMode",
+    "Gear",
+    "Machine",
+    "Mesh",
+    "Meta",
+    "Motor",
+    "Operation",
+    "Production",
+    "Profile",
+    "Scenario",
+    "ScenarioError",
+    "Shaft",
+    "Solver",
+    "dump_scenario",
+    "load_scenario",
+    "parse_override",
+    "scenario_to_dict",
 ]

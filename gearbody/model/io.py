@@ -65,8 +65,9 @@ def apply_overrides(data: dict[str, Any], overrides: dict[str, Any] | list[str] 
     return out
 
 
-def load_scenario(source: str | Path | dict[str, Any], overrides: dict[str, Any] | list[str] | None = None
-                  ) -> Scenario:
+def load_scenario(
+    source: str | Path | dict[str, Any], overrides: dict[str, Any] | list[str] | None = None
+) -> Scenario:
     """Build a validated :class:`Scenario` from a TOML path, a scene name, or a nested dict."""
     if isinstance(source, dict):
         data, name = source, "<dict>"

@@ -42,10 +42,16 @@ def describe_range(meta: typing.Mapping[str, Any]) -> str:
     """Human text for a field's allowed range, e.g. '> 0', '[0, 1]'."""
     if meta.get("choices"):
         return "one of " + ", ".join(repr(c) for c in meta["choices"])
-    lo = f"> {meta['gt']:g}" if meta.get("gt") is not None else (
-        f">= {meta['ge']:g}" if meta.get("ge") is not None else "")
-    hi = f"< {meta['lt']:g}" if meta.get("lt") is not None else (
-        f"<= {meta['le']:g}" if meta.get("le") is not None else "")
+    lo = (
+        f"> {meta['gt']:g}"
+        if meta.get("gt") is not None
+        else (f">= {meta['ge']:g}" if meta.get("ge") is not None else "")
+    )
+    hi = (
+        f"< {meta['lt']:g}"
+        if meta.get("lt") is not None
+        else (f"<= {meta['le']:g}" if meta.get("le") is not None else "")
+    )
     if lo and hi:
         return f"{lo} and {hi}"
     return lo or hi or "any value"
@@ -126,8 +132,11 @@ def _from_dict(cls: type, data: typing.Mapping[str, Any], ctx: _Ctx) -> Any:
     for key in data:
         if key not in fields:
             near = difflib.get_close_matches(key, list(fields), n=1, cutoff=0.5)
-            hint = (f"; did you mean {ctx.child(near[0]).path!r}?" if near
-                    else f"; valid keys here: {', '.join(fields)}")
+            hint = (
+                f"; did you mean {ctx.child(near[0]).path!r}?"
+                if near
+                else f"; valid keys here: {', '.join(fields)}"
+            )
             raise ScenarioError(f"{ctx.source}: unknown key {ctx.child(key).path!r}{hint}")
     kwargs = {}
     for name, f in fields.items():
@@ -137,7 +146,8 @@ def _from_dict(cls: type, data: typing.Mapping[str, Any], ctx: _Ctx) -> Any:
                 doc = f.metadata.get("doc", "")
                 raise ScenarioError(
                     f"{ctx.source}: missing required key {sub.path!r}"
-                    + (f" ({doc}; {describe_range(f.metadata)})" if doc else ""))
+                    + (f" ({doc}; {describe_range(f.metadata)})" if doc else "")
+                )
             continue
         kwargs[name] = _convert(data[name], hints[name], sub, f.metadata)
     try:

@@ -8,7 +8,7 @@ reported are exactly the ones integrated. All parameters travel in one float64 a
 Conventions (docs/scenario.md): mesh phase ``p = frac(phi_p z1 / 2 pi)`` from the computed pinion angle;
 pinion tooth ``i = n mod z1`` and wheel tooth ``j = n mod z2`` with ``n = floor(phi_p z1 / 2 pi)``;
 ``d = delta + E(p)``, ``F_el = k (max(d - l_u, min(d + l_u, 0)))``; damping only in contact;
-friction ``T = mu F s(p)`` reversing at the pitch point, arms ``rho_1, rho_2`` along the line of action.
+friction ``T = mu |F| s(p)`` reversing at the pitch point, arms ``rho_1, rho_2`` along the line of action.
 """
 
 from __future__ import annotations
@@ -59,14 +59,20 @@ def pack_mesh_parameters(
     tk = np.zeros(0) if table_stiffness_N_per_m is None else np.asarray(table_stiffness_N_per_m, float)
     e = np.asarray(error_depths_m, float)
     if e.shape != (z1,) or f.shape != (z1,) or g.shape != (z2,) or tp.shape != tk.shape:
-        raise ValueError("per-tooth arrays must have z1 (errors, pinion factors) or z2 (wheel factors) values")
+        raise ValueError(
+            "per-tooth arrays must have z1 (errors, pinion factors) or z2 (wheel factors) values"
+        )
     head = np.zeros(I_HEADER)
     head[I_R1], head[I_R2], head[I_Z1], head[I_Z2] = r1_m, r2_m, z1, z2
     head[I_KIND] = PROFILE_TABLE if tp.size else PROFILE_CONTACT_RATIO
     head[I_KSINGLE], head[I_KDOUBLE] = stiffness_single_N_per_m, stiffness_double_N_per_m
     head[I_HALF_DOUBLE] = 0.5 * (contact_ratio - 1.0)
     head[I_CZ], head[I_LU], head[I_MU], head[I_PITCH] = (
-        damping_Ns_per_m, backlash_m, friction_coefficient, pitch_point_phase)
+        damping_Ns_per_m,
+        backlash_m,
+        friction_coefficient,
+        pitch_point_phase,
+    )
     head[I_ARM1] = r1_m * math.tan(pressure_angle_rad)
     head[I_ARM2] = r2_m * math.tan(pressure_angle_rad)
     head[I_PB] = 2.0 * math.pi * r1_m / z1
@@ -84,16 +90,22 @@ def mesh_parameters_from_scenario(scenario, *, friction: bool = True) -> np.ndar
         (f if tooth.gear == "pinion" else g)[tooth.tooth] *= tooth.stiffness_factor
     table = mesh.stiffness_profile == "table"
     return pack_mesh_parameters(
-        r1_m=d.pinion.base_radius_m, r2_m=d.wheel.base_radius_m, z1=z1, z2=z2,
+        r1_m=d.pinion.base_radius_m,
+        r2_m=d.wheel.base_radius_m,
+        z1=z1,
+        z2=z2,
         stiffness_single_N_per_m=mesh.stiffness_single_N_per_m,
         stiffness_double_N_per_m=mesh.stiffness_double_N_per_m,
-        contact_ratio=mesh.contact_ratio, damping_Ns_per_m=mesh.damping_Ns_per_m,
+        contact_ratio=mesh.contact_ratio,
+        damping_Ns_per_m=mesh.damping_Ns_per_m,
         backlash_m=mesh.backlash_um * 1e-6,
         friction_coefficient=scenario.condition.friction_coefficient if friction else 0.0,
         pitch_point_phase=mesh.pitch_point_phase,
         pressure_angle_rad=math.radians(mesh.pressure_angle_deg),
-        error_a=em.a, error_depths_m=tooth_error_depths_m(em.e_um, em.r, z1, scenario.meta.seed),
-        pinion_factors=f, wheel_factors=g,
+        error_a=em.a,
+        error_depths_m=tooth_error_depths_m(em.e_um, em.r, z1, scenario.meta.seed),
+        pinion_factors=f,
+        wheel_factors=g,
         table_phase=np.array(mesh.table_phase) if table else None,
         table_stiffness_N_per_m=np.array(mesh.table_stiffness_N_per_m) if table else None,
     )
@@ -107,8 +119,8 @@ def stiffness_at_phase(p: float, P: np.ndarray) -> float:
         return P[I_KDOUBLE] if (p < h or p >= 1.0 - h) else P[I_KSINGLE]
     z1, z2, n = int(P[I_Z1]), int(P[I_Z2]), int(P[I_NTAB])
     o = I_HEADER + 2 * z1 + z2
-    ph = P[o:o + n]
-    kk = P[o + n:o + 2 * n]
+    ph = P[o : o + n]
+    kk = P[o + n : o + 2 * n]
     if p < ph[0]:  # wrap between the last point (shifted by -1) and the first
         x0, k0, x1, k1 = ph[n - 1] - 1.0, kk[n - 1], ph[0], kk[0]
     elif p >= ph[n - 1]:
@@ -151,7 +163,7 @@ def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float,
     else:
         F = 0.0
     dp = p - P[I_PITCH]
-    T = P[I_MU] * F if dp < 0.0 else -P[I_MU] * F
+    T = P[I_MU] * abs(F) if dp < 0.0 else -P[I_MU] * abs(F)  # |F|: dissipative on the back flank too
     rho1 = P[I_ARM1] + dp * P[I_PB]
     rho2 = P[I_ARM2] - dp * P[I_PB]
     return F, T, rho1, rho2
@@ -166,8 +178,9 @@ def torsional_mesh_forces(phi_p: float, phi_w: float, w_p: float, w_w: float, P:
 
 
 @njit(cache=True)
-def mesh_contact_series(pinion_angle_rad: np.ndarray, delta_m: np.ndarray, delta_rate_m_s: np.ndarray,
-                        P: np.ndarray):
+def mesh_contact_series(
+    pinion_angle_rad: np.ndarray, delta_m: np.ndarray, delta_rate_m_s: np.ndarray, P: np.ndarray
+):
     """:func:`mesh_contact` over arrays: returns (F, T) in N."""
     nt = pinion_angle_rad.size
     F = np.empty(nt)
@@ -201,6 +214,6 @@ def mean_stiffness_N_per_m(P: np.ndarray) -> float:
         return float(h2 * P[I_KDOUBLE] + (1.0 - h2) * P[I_KSINGLE])
     z1, z2, n = int(P[I_Z1]), int(P[I_Z2]), int(P[I_NTAB])
     o = I_HEADER + 2 * z1 + z2
-    ph = np.append(P[o:o + n], P[o] + 1.0)
-    kk = np.append(P[o + n:o + 2 * n], P[o + n])
+    ph = np.append(P[o : o + n], P[o] + 1.0)
+    kk = np.append(P[o + n : o + 2 * n], P[o + n])
     return float(np.sum(0.5 * (kk[1:] + kk[:-1]) * np.diff(ph)))

@@ -11,8 +11,13 @@ from .profiles import profile_integral, profile_value
 
 
 @njit(cache=True)
-def kloss_torque_Nm(speed_rad_s: float, synchronous_speed_rad_s: float, rated_synchronous_speed_rad_s: float,
-                    breakdown_torque_Nm: float, breakdown_slip: float) -> float:
+def kloss_torque_Nm(
+    speed_rad_s: float,
+    synchronous_speed_rad_s: float,
+    rated_synchronous_speed_rad_s: float,
+    breakdown_torque_Nm: float,
+    breakdown_slip: float,
+) -> float:
     """Kloss torque M_s = 2 M_b s s_b / (s^2 + s_b^2).
 
     The slip is the slip *speed* over the rated synchronous speed, ``s = (w_s(t) - w) / w_s,rated``:
@@ -31,14 +36,17 @@ def steady_slip(load_torque_Nm: float, breakdown_torque_Nm: float, breakdown_sli
     if load_torque_Nm == 0.0:
         return 0.0
     if abs(load_torque_Nm) > breakdown_torque_Nm:
-        raise ValueError(f"load torque {load_torque_Nm:.6g} N m exceeds the motor's breakdown torque "
-                         f"{breakdown_torque_Nm:.6g} N m: the motor cannot carry it")
+        raise ValueError(
+            f"load torque {load_torque_Nm:.6g} N m exceeds the motor's breakdown torque "
+            f"{breakdown_torque_Nm:.6g} N m: the motor cannot carry it"
+        )
     mb, m = breakdown_torque_Nm, load_torque_Nm
     return breakdown_slip * (mb - math.copysign(math.sqrt(mb * mb - m * m), m)) / m
 
 
-def viscous_equivalent_Nms(breakdown_torque_Nm: float, breakdown_slip: float,
-                           synchronous_speed_rad_s: float) -> float:
+def viscous_equivalent_Nms(
+    breakdown_torque_Nm: float, breakdown_slip: float, synchronous_speed_rad_s: float
+) -> float:
     """Slope -dM/dw of the Kloss curve at synchronous speed: c_e = 2 M_b / (s_b w_s)."""
     return 2.0 * breakdown_torque_Nm / (breakdown_slip * synchronous_speed_rad_s)
 
@@ -53,22 +61,30 @@ def pack_drive_parameters(scenario) -> np.ndarray:
     m, op = scenario.design.motor, scenario.operation
     st, sf = np.asarray(op.speed_profile.time_s, float), np.asarray(op.speed_profile.fraction, float)
     lt, lf = np.asarray(op.load_profile.time_s, float), np.asarray(op.load_profile.fraction, float)
-    head = np.array([m.synchronous_speed_rad_s, m.breakdown_torque_Nm, m.breakdown_slip,
-                     scenario.design.machine.rated_torque_Nm, st.size, lt.size])
+    head = np.array(
+        [
+            m.synchronous_speed_rad_s,
+            m.breakdown_torque_Nm,
+            m.breakdown_slip,
+            scenario.design.machine.rated_torque_Nm,
+            st.size,
+            lt.size,
+        ]
+    )
     return np.concatenate([head, st, sf, lt, lf])
 
 
 @njit(cache=True)
 def _speed_profile(D):
     n = int(D[4])
-    return D[6:6 + n], D[6 + n:6 + 2 * n]
+    return D[6 : 6 + n], D[6 + n : 6 + 2 * n]
 
 
 @njit(cache=True)
 def _load_profile(D):
     n, k = int(D[4]), int(D[5])
     o = 6 + 2 * n
-    return D[o:o + k], D[o + k:o + 2 * k]
+    return D[o : o + k], D[o + k : o + 2 * k]
 
 
 @njit(cache=True)

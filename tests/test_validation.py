@@ -1,0 +1,36 @@
+"""gearbody agrees with the independent reference (short version of `gearbody validate`)."""
+
+import numpy as np
+import pytest
+from gearbody.validation.compare import cases, compare_case, run_validation
+from gearbody.validation.reference import simulate_reference
+
+from gearbody.engine import simulate
+from gearbody.model import SCENES, load_scenario, scenario_to_dict
+
+
+@pytest.mark.parametrize("scene", SCENES)
+def test_scene_agrees_with_independent_reference_within_half_a_percent(scene):
+    for case in cases(scene, short=True):
+        r = compare_case(scene, case, short=True)
+        assert r.max_error_percent <= 0.5, (scene, case.name, r.max_error_percent)
+        if case.must_separate:
+            assert r.kd_max > 2.0 and r.separated_fraction > 0.05
+
+
+def test_comparison_detects_a_model_difference():
+    """The yardstick can fail: a reference run with 20 % more mesh damping is far outside 0.5 %."""
+    sc = load_scenario("one-stage", [*cases("one-stage")[0].overrides, "operation.t_end_s=0.05"])
+    res = simulate(sc)
+    other = scenario_to_dict(sc)
+    other["design"]["mesh"]["damping_Ns_per_m"] *= 1.2
+    other["production"]["error_mode"]["e_um"] = 12.0
+    ref = simulate_reference(other, t_eval=res.time_s)
+    assert np.max(np.abs(res.mesh_force - ref["mesh_force_N"])) / sc.rated_mesh_force_N > 0.005
+
+
+def test_validate_command_prints_a_table_and_reports_failure(capsys):
+    lines = []
+    assert run_validation(["two-wheel"], short=True, echo=lines.append)
+    assert any(line.startswith("two-wheel  steady") for line in lines)
+    assert not run_validation(["two-wheel"], short=True, tolerance_percent=1e-9, echo=lines.append)
