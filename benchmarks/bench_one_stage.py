@@ -37,6 +37,11 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--reference", action="store_true", help="also time the scipy reference")
     ap.add_argument("--write", action="store_true", help="append the table to benchmarks/RESULTS.md")
+    ap.add_argument(
+        "--sweep",
+        action="store_true",
+        help="also run tolerances 1e-9..1e-12 and give each one's max |dF|/F_rated vs the reference",
+    )
     args = ap.parse_args()
     sc = load_scenario("one-stage", [*RATED, f"operation.t_end_s={args.t_end}"])
     t0 = time.perf_counter()
@@ -70,6 +75,33 @@ def main() -> None:
             f"| scipy reference (validation/reference.py) | {wref / args.t_end:.3f} | - | - | "
             f"max dF {err:.3f} % of F_rated vs gearbody; ratio reference/gearbody {wref / wall:.1f} |"
         )
+    if args.sweep:
+        from gearbody.validation.reference import simulate_reference
+
+        ref = simulate_reference(scenario_to_dict(sc), t_eval=res.time_s)
+        lines += [
+            "",
+            "| rtol = atol | wall s per simulated s | steps | rejected | max dF % of F_rated vs reference |",
+            "|---|---|---|---|---|",
+        ]
+        for tol in (1e-9, 1e-10, 1e-11, 1e-12):
+            sct = load_scenario(
+                "one-stage",
+                [
+                    *RATED,
+                    f"operation.t_end_s={args.t_end}",
+                    f"solver.relative_tolerance={tol}",
+                    f"solver.absolute_tolerance={tol}",
+                ],
+            )
+            t0 = time.perf_counter()
+            rt = simulate(sct)
+            wt = time.perf_counter() - t0
+            err = np.max(np.abs(rt.mesh_force - ref["mesh_force_N"])) / sc.rated_mesh_force_N * 100
+            st = rt.meta["solver_statistics"]
+            lines.append(
+                f"| {tol:g} | {wt / args.t_end:.3f} | {st['steps']} | {st['rejected_steps']} | {err:.4f} |"
+            )
     text = "\n".join(lines) + "\n"
     print(text)
     if args.write:
