@@ -13,7 +13,7 @@ import numpy as np
 
 from ..model import Scenario
 from ..physics import mesh_parameters_from_scenario, pack_drive_parameters, steady_slip
-from ..physics.mesh import mesh_contact
+from ..physics.mesh import stiffness_at_phase, tooth_pair_factor
 
 
 @dataclass(frozen=True)
@@ -107,11 +107,11 @@ def steady_operating_point(scenario: Scenario) -> dict[str, float]:
     s = steady_slip(pinion_torque, d.motor.breakdown_torque_Nm, d.motor.breakdown_slip)
     ws0 = d.motor.synchronous_speed_rad_s * np.interp(0.0, op.speed_profile.time_s, op.speed_profile.fraction)
     w = ws0 - s * d.motor.synchronous_speed_rad_s
+    # stiffness in mesh at p = 0: pinion tooth 0 against wheel tooth 0
     P = mesh_parameters_from_scenario(scenario)
-    k0 = 0.0
-    if F0 > 0:  # stiffness in mesh at p = 0, tooth 0: force per unit deflection beyond the dead zone
-        lu = d.mesh.backlash_um * 1e-6
-        k0 = mesh_contact(0.0, lu + 1e-9, 0.0, P)[0] / 1e-9
+    k0 = stiffness_at_phase(0.0, P) * tooth_pair_factor(0, 0, P)
+    if F0 > 0 and k0 <= 0:
+        raise ValueError("the teeth in mesh at the start carry no load (stiffness factor 0): start from rest")
     delta0 = F0 / k0 + d.mesh.backlash_um * 1e-6 if F0 > 0 else 0.0
     return {
         "load_torque_Nm": load,

@@ -132,6 +132,13 @@ def stiffness_at_phase(p: float, P: np.ndarray) -> float:
 
 
 @njit(cache=True)
+def tooth_pair_factor(i: int, j: int, P: np.ndarray) -> float:
+    """Stiffness factor of pinion tooth i meshing with wheel tooth j (change-of-condition factors)."""
+    z1 = int(P[I_Z1])
+    return P[I_HEADER + z1 + i] * P[I_HEADER + 2 * z1 + j]
+
+
+@njit(cache=True)
 def error_shape(p: float, a: float) -> float:
     """Triangular error shape of Fig. 4 (b, c): 0 at p = 0 and 1, maximum 1 at p = a."""
     if p < a:
@@ -152,7 +159,7 @@ def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float,
     p = u - n
     i = int(n % z1)
     j = int(n % z2)
-    factor = P[I_HEADER + z1 + i] * P[I_HEADER + 2 * z1 + j]
+    factor = tooth_pair_factor(i, j, P)
     k = stiffness_at_phase(p, P) * factor
     d = delta_m + P[I_HEADER + i] * error_shape(p, P[I_A])
     lu = P[I_LU]
