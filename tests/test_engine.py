@@ -93,3 +93,8 @@ def test_muller_pitch_line_is_kinematic():
 def test_motor_that_cannot_carry_the_load_is_reported_before_running():
     with pytest.raises(SimulationError, match="breakdown torque"):
         simulate(steady("one-stage", "design.machine.rated_torque_Nm=6000"))
+
+
+def test_steady_start_on_a_broken_tooth_is_refused_with_a_hint():
+    with pytest.raises(SimulationError, match="carry no load"):
+        simulate(steady("one-stage", 'condition.damaged_teeth=[{gear="pinion",tooth=0,stiffness_factor=0.0}]'))
