@@ -97,4 +97,5 @@ def test_motor_that_cannot_carry_the_load_is_reported_before_running():
 
 def test_steady_start_on_a_broken_tooth_is_refused_with_a_hint():
     with pytest.raises(SimulationError, match="carry no load"):
-        simulate(steady("one-stage", 'condition.damaged_teeth=[{gear="pinion",tooth=0,stiffness_factor=0.0}]'))
+        broken = 'condition.damaged_teeth=[{gear="pinion",tooth=0,stiffness_factor=0.0}]'
+        simulate(steady("one-stage", broken))
