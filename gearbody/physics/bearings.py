@@ -1,0 +1,133 @@
+"""Bearing force laws: the extension point for bearing compliance. Engine-free.
+
+A bearing law maps the relative displacement u = (u_x, u_y) in m and velocity v in m/s of a journal
+(gear centre) with respect to its housing to the force (N) that the bearing exerts *on the journal*.
+Any object with that ``force_N`` method is a bearing; register it under a name to make it available
+to scenarios:
+
+    @dataclass(frozen=True)
+    class MyBearing:
+        stiffness_N_per_m: float
+
+        def force_N(self, displacement_m, velocity_m_s):
+            return -self.stiffness_N_per_m * np.asarray(displacement_m, float)
+
+    register_bearing("mine", MyBearing)
+
+The engine (issue 3) wraps any law in one user-function connector between gear and housing; it never
+needs to know which law it is.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+
+@runtime_checkable
+class BearingLaw(Protocol):
+    def force_N(self, displacement_m: np.ndarray, velocity_m_s: np.ndarray) -> np.ndarray:
+        """Force on the journal (N, 2 components) from its displacement and velocity."""
+        ...
+
+
+@dataclass(frozen=True)
+class LinearBearing:
+    """Linear spring-damper per direction (the paper's k_x, k_y, C_x, C_y of Figs. 17-18)."""
+
+    stiffness_x_N_per_m: float
+    stiffness_y_N_per_m: float
+    damping_x_Ns_per_m: float = 0.0
+    damping_y_Ns_per_m: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("stiffness_x_N_per_m", "stiffness_y_N_per_m"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"LinearBearing.{name} = {getattr(self, name)!r}: must be > 0")
+        for name in ("damping_x_Ns_per_m", "damping_y_Ns_per_m"):
+            if not getattr(self, name) >= 0:
+                raise ValueError(f"LinearBearing.{name} = {getattr(self, name)!r}: must be >= 0")
+
+    def force_N(self, displacement_m, velocity_m_s) -> np.ndarray:
+        u = np.asarray(displacement_m, float)
+        v = np.asarray(velocity_m_s, float)
+        return -np.array(
+            [
+                self.stiffness_x_N_per_m * u[0] + self.damping_x_Ns_per_m * v[0],
+                self.stiffness_y_N_per_m * u[1] + self.damping_y_Ns_per_m * v[1],
+            ]
+        )
+
+
+@dataclass(frozen=True)
+class HertzianBearing:
+    """Rolling-element bearing with radial clearance and Hertzian contact.
+
+    Radial force ``k_b max(0, |u| - c)^n`` towards the bearing centre, with n = 3/2 for ball bearings
+    (10/9 is used for roller bearings), plus a radial damping ``C u_r'`` while in contact. This is the
+    lumped (isotropic) form; a per-element model with ball passage is a later refinement.
+    """
+
+    contact_stiffness_N_per_m_n: float
+    radial_clearance_m: float = 0.0
+    exponent: float = 1.5
+    damping_Ns_per_m: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not self.contact_stiffness_N_per_m_n > 0:
+            raise ValueError(
+                f"HertzianBearing.contact_stiffness_N_per_m_n = {self.contact_stiffness_N_per_m_n!r}: "
+                "must be > 0"
+            )
+        if not self.radial_clearance_m >= 0:
+            raise ValueError(
+                f"HertzianBearing.radial_clearance_m = {self.radial_clearance_m!r}: must be >= 0"
+            )
+        if not 1.0 <= self.exponent <= 2.0:
+            raise ValueError(
+                f"HertzianBearing.exponent = {self.exponent!r}: must be in [1, 2] (3/2 ball, 10/9 roller)"
+            )
+        if not self.damping_Ns_per_m >= 0:
+            raise ValueError(f"HertzianBearing.damping_Ns_per_m = {self.damping_Ns_per_m!r}: must be >= 0")
+
+    def force_N(self, displacement_m, velocity_m_s) -> np.ndarray:
+        u = np.asarray(displacement_m, float)
+        v = np.asarray(velocity_m_s, float)
+        r = math.hypot(u[0], u[1])
+        penetration = r - self.radial_clearance_m
+        if penetration <= 0.0 or r == 0.0:
+            return np.zeros(2)
+        e = u / r
+        radial = self.contact_stiffness_N_per_m_n * penetration**self.exponent + self.damping_Ns_per_m * (
+            v @ e
+        )
+        return -max(radial, 0.0) * e  # a bearing pushes, it never pulls
+
+    def potential_J(self, displacement_m) -> float:
+        """Elastic energy stored in the contact (for checks): k_b p^(n+1) / (n+1)."""
+        p = max(0.0, math.hypot(*np.asarray(displacement_m, float)) - self.radial_clearance_m)
+        return self.contact_stiffness_N_per_m_n * p ** (self.exponent + 1) / (self.exponent + 1)
+
+
+BEARINGS: dict[str, type] = {"linear": LinearBearing, "hertzian": HertzianBearing}
+
+
+def register_bearing(kind: str, cls: type) -> None:
+    """Make a bearing law available to scenarios under ``kind``."""
+    if not hasattr(cls, "force_N"):
+        raise TypeError(f"{cls.__name__} has no force_N(displacement_m, velocity_m_s) method")
+    BEARINGS[kind] = cls
+
+
+def make_bearing(kind: str, **parameters: float) -> BearingLaw:
+    """Bearing of a registered kind; unknown kinds name the registered ones."""
+    try:
+        cls = BEARINGS[kind]
+    except KeyError:
+        raise ValueError(
+            f"bearing kind {kind!r} is not registered; kinds: {', '.join(sorted(BEARINGS))}"
+        ) from None
+    return cls(**parameters)
