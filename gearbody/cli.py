@@ -142,10 +142,10 @@ def cmd_modes(args) -> int:
 
     scenario = _load(args.scene, args.overrides)
     modes = scene_modes(scenario)
-    z1 = scenario.design.pinion.teeth
-    k = modes.mean_mesh_stiffness_N_per_m
+    z1 = scenario.stages[0].pinion.teeth
+    k = ", ".join(f"{x:.4g}" for x in modes.mean_mesh_stiffness_N_per_m)
     print(f"{scenario.meta.title}")
-    print(f"linearised at mean mesh stiffness {k:.4g} N/m; DOFs: {', '.join(modes.dof_names)}")
+    print(f"linearised at mean mesh stiffness {k} N/m; DOFs: {', '.join(modes.dof_names)}")
     speeds = resonance_speeds_rad_s(modes, z1, args.harmonics)
     head = "".join(f"  w({h}f_z) rad/s  " for h in range(1, args.harmonics + 1))
     print(f"{'mode':>4} {'f_n Hz':>12}  {'dominant DOF':<12}{head}")

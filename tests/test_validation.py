@@ -2,14 +2,14 @@
 
 import numpy as np
 import pytest
-from gearbody.validation.compare import cases, compare_case, run_validation
+from gearbody.validation.compare import VALIDATED_SCENES, cases, compare_case, run_validation
 from gearbody.validation.reference import simulate_reference
 
 from gearbody.engine import simulate
-from gearbody.model import SCENES, load_scenario, scenario_to_dict
+from gearbody.model import load_scenario, scenario_to_dict
 
 
-@pytest.mark.parametrize("scene", SCENES)
+@pytest.mark.parametrize("scene", VALIDATED_SCENES)
 def test_scene_agrees_with_independent_reference_within_half_a_percent(scene):
     for case in cases(scene, short=True):
         r = compare_case(scene, case, short=True)

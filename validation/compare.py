@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+VALIDATED_SCENES = ("muller", "two-wheel", "one-stage")  # scene files with validation cases
+
 STEADY = [
     'operation.initial_state="steady"',
     "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
@@ -128,9 +130,7 @@ def run_validation(
     scenes: list[str] | None = None, short: bool = False, tolerance_percent: float = 0.5, echo=print
 ) -> bool:
     """Run every case of the given scenes, print a table, return True when all pass."""
-    from gearbody.model import SCENES
-
-    scenes = list(scenes or SCENES)
+    scenes = list(scenes or VALIDATED_SCENES)
     echo(
         "gearbody vs independent reference (scipy solve_ivp): max |dF|/F_rated, "
         f"tolerance {tolerance_percent} %" + (" [short runs]" if short else "")

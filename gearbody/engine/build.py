@@ -80,7 +80,8 @@ def build_torsional(
 ) -> BuiltSystem:
     """Exudyn system of a torsional layout.
 
-    With ``modal_mesh_stiffness_N_per_m`` the meshes are constant line-of-action springs of that
+    With ``modal_mesh_stiffness_N_per_m`` (one value for all meshes, or one per mesh) the meshes are
+    constant line-of-action springs of that
     stiffness (no backlash, errors or friction), and the motor and load are left out: the linearised
     system for natural frequencies.
     """
@@ -100,11 +101,14 @@ def build_torsional(
                 damping=s.damping_Nms_per_rad,
             )
         )
-    for m in layout.meshes:
+    modal = modal_mesh_stiffness_N_per_m is not None
+    if modal:
+        k_modal = np.broadcast_to(np.asarray(modal_mesh_stiffness_N_per_m, float), (len(layout.meshes),))
+    for index, m in enumerate(layout.meshes):
         pair = [nodes[m.pinion], nodes[m.wheel]]
-        if modal_mesh_stiffness_N_per_m is not None:
+        if modal:
             r1, r2 = m.r_pinion_m, m.r_wheel_m
-            K = modal_mesh_stiffness_N_per_m * np.array([[r1 * r1, -r1 * r2], [-r1 * r2, r2 * r2]])
+            K = k_modal[index] * np.array([[r1 * r1, -r1 * r2], [-r1 * r2, r2 * r2]])
             mbs.AddObject(
                 ObjectGenericODE2(
                     nodeNumbers=pair, massMatrix=np.zeros((2, 2)), stiffnessMatrix=K, visualization=HIDDEN
@@ -120,7 +124,7 @@ def build_torsional(
                 visualization=HIDDEN,
             )
         )
-    if modal_mesh_stiffness_N_per_m is None:
+    if not modal:
         D = layout.drive
         if layout.motor_at is not None:
             built.user_functions.append(_motor_user_function(D))

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..model import Scenario
 from ..physics import mesh_parameters_from_scenario, pack_drive_parameters, steady_slip
-from ..physics.mesh import stiffness_at_phase, tooth_pair_factor
+from ..physics.mesh import mesh_phase_series, stiffness_at_phase, tooth_error_m, tooth_pair_factor
 
 
 @dataclass(frozen=True)
@@ -57,33 +57,50 @@ class TorsionalLayout:
         return [b.name for b in self.inertias]
 
 
-def torsional_layout(scenario: Scenario) -> TorsionalLayout:
-    """Layout of the ``one-stage`` (Fig. 3) and ``two-wheel`` (Fig. 2) scenes."""
+def gear_names(stage: int) -> tuple[str, str]:
+    """Names of a stage's gears: ``pinion``/``wheel`` for the first, ``pinion_2``/``wheel_2``... after."""
+    return ("pinion", "wheel") if stage == 0 else (f"pinion_{stage + 1}", f"wheel_{stage + 1}")
+
+
+def chain_shafts(scenario: Scenario) -> tuple:
+    """Shafts in chain order: motor -> stage 1, ..., last stage -> machine."""
     d = scenario.design
-    P = mesh_parameters_from_scenario(scenario)
+    return d.shafts if scenario.meta.scene == "train" else (d.coupling, d.output_shaft)
+
+
+def torsional_layout(scenario: Scenario) -> TorsionalLayout:
+    """Layout of the torsional scenes: ``two-wheel`` (Fig. 2), ``one-stage`` (Fig. 3) and any ``train``
+    (Fig. 19 for two stages): motor, then each stage's pinion and wheel, then the machine."""
+    d = scenario.design
     drive = pack_drive_parameters(scenario)
-    r1, r2 = d.pinion.base_radius_m, d.wheel.base_radius_m
-    if scenario.meta.scene == "one-stage":
-        inertias = (
-            Inertia("motor", d.motor.inertia_kg_m2),
-            Inertia("pinion", d.pinion.inertia_kg_m2),
-            Inertia("wheel", d.wheel.inertia_kg_m2),
-            Inertia("machine", d.machine.inertia_kg_m2),
-        )
-        shafts = (
-            ShaftLink(0, 1, d.coupling.stiffness_Nm_per_rad, d.coupling.damping_Nms_per_rad),
-            ShaftLink(2, 3, d.output_shaft.stiffness_Nm_per_rad, d.output_shaft.damping_Nms_per_rad),
-        )
-        return TorsionalLayout(
-            inertias, shafts, (MeshLink(1, 2, r1, r2, P),), motor_at=0, load_at=3, drive=drive
-        )
+    stages = scenario.stages
+    params = [mesh_parameters_from_scenario(scenario, k) for k in range(len(stages))]
     if scenario.meta.scene == "two-wheel":
+        st = stages[0]
         inertias = (
-            Inertia("pinion", d.motor.inertia_kg_m2 + d.pinion.inertia_kg_m2),
-            Inertia("wheel", d.wheel.inertia_kg_m2 + d.machine.inertia_kg_m2),
+            Inertia("pinion", d.motor.inertia_kg_m2 + st.pinion.inertia_kg_m2),
+            Inertia("wheel", st.wheel.inertia_kg_m2 + d.machine.inertia_kg_m2),
         )
-        return TorsionalLayout(inertias, (), (MeshLink(0, 1, r1, r2, P),), motor_at=0, load_at=1, drive=drive)
-    raise ValueError(f"scene {scenario.meta.scene!r} has no torsional layout")
+        mesh = MeshLink(0, 1, st.pinion.base_radius_m, st.wheel.base_radius_m, params[0])
+        return TorsionalLayout(inertias, (), (mesh,), motor_at=0, load_at=1, drive=drive)
+    if scenario.meta.scene not in ("one-stage", "train"):
+        raise ValueError(f"scene {scenario.meta.scene!r} has no torsional layout")
+    inertias = [Inertia("motor", d.motor.inertia_kg_m2)]
+    meshes = []
+    for k, st in enumerate(stages):
+        pname, wname = gear_names(k)
+        inertias += [Inertia(pname, st.pinion.inertia_kg_m2), Inertia(wname, st.wheel.inertia_kg_m2)]
+        meshes.append(
+            MeshLink(2 * k + 1, 2 * k + 2, st.pinion.base_radius_m, st.wheel.base_radius_m, params[k])
+        )
+    inertias.append(Inertia("machine", d.machine.inertia_kg_m2))
+    shafts = tuple(
+        ShaftLink(2 * k, 2 * k + 1, sh.stiffness_Nm_per_rad, sh.damping_Nms_per_rad)
+        for k, sh in enumerate(chain_shafts(scenario))
+    )
+    return TorsionalLayout(
+        tuple(inertias), shafts, tuple(meshes), motor_at=0, load_at=len(inertias) - 1, drive=drive
+    )
 
 
 def reduced_mass_kg(scenario: Scenario) -> float:
@@ -94,65 +111,85 @@ def reduced_mass_kg(scenario: Scenario) -> float:
     )
 
 
-def steady_operating_point(scenario: Scenario) -> dict[str, float]:
-    """Steady running at t = 0 (friction and error ignored): speeds, mesh force and deflection.
+def steady_operating_point(scenario: Scenario) -> dict[str, object]:
+    """Steady running at t = 0 (friction ignored), stage by stage: speeds, mesh forces, deflections.
 
-    Raises a ValueError when the motor cannot carry the initial load.
+    Returns per-stage lists ``mesh_force_N``, ``pinion_torque_Nm``, ``pinion_speed_rad_s``,
+    ``wheel_speed_rad_s``, plus ``load_torque_Nm``. Raises ValueError when the motor cannot carry the
+    initial load.
     """
     d, op = scenario.design, scenario.operation
+    stages = scenario.stages
     load = d.machine.rated_torque_Nm * np.interp(0.0, op.load_profile.time_s, op.load_profile.fraction)
-    r1, r2 = d.pinion.base_radius_m, d.wheel.base_radius_m
-    F0 = load / r2
-    pinion_torque = F0 * r1
-    s = steady_slip(pinion_torque, d.motor.breakdown_torque_Nm, d.motor.breakdown_slip)
+    fraction = load / d.machine.rated_torque_Nm
+    forces = [fraction * scenario.stage_rated_force_N(k) for k in range(len(stages))]
+    pinion_torques = [f * st.pinion.base_radius_m for f, st in zip(forces, stages, strict=True)]
+    s = steady_slip(pinion_torques[0], d.motor.breakdown_torque_Nm, d.motor.breakdown_slip)
     ws0 = d.motor.synchronous_speed_rad_s * np.interp(0.0, op.speed_profile.time_s, op.speed_profile.fraction)
     w = ws0 - s * d.motor.synchronous_speed_rad_s
-    # stiffness in mesh at p = 0: pinion tooth 0 against wheel tooth 0
-    P = mesh_parameters_from_scenario(scenario)
-    k0 = stiffness_at_phase(0.0, P) * tooth_pair_factor(0, 0, P)
-    if F0 > 0 and k0 <= 0:
-        raise ValueError("the teeth in mesh at the start carry no load (stiffness factor 0): start from rest")
-    delta0 = F0 / k0 + d.mesh.backlash_um * 1e-6 if F0 > 0 else 0.0
+    pinion_speeds, wheel_speeds = [], []
+    for st in stages:
+        pinion_speeds.append(w)
+        w = w * st.pinion.base_radius_m / st.wheel.base_radius_m  # r_p w_p = r_w w_w: no deflection rate
+        wheel_speeds.append(w)
     return {
         "load_torque_Nm": load,
-        "mesh_force_N": F0,
-        "pinion_torque_Nm": pinion_torque,
-        "pinion_speed_rad_s": w,
-        "wheel_speed_rad_s": w * r1 / r2,
-        "deflection_m": delta0,
+        "mesh_force_N": forces,
+        "pinion_torque_Nm": pinion_torques,
+        "pinion_speed_rad_s": pinion_speeds,
+        "wheel_speed_rad_s": wheel_speeds,
     }
+
+
+def static_deflection_m(scenario: Scenario, stage: int, pinion_angle_rad: float, force_N: float) -> float:
+    """Mesh deflection carrying ``force_N`` at the teeth and phase in mesh at ``pinion_angle_rad``:
+    delta = F / k + l_u - E (0 without load)."""
+    if force_N == 0.0:
+        return 0.0
+    P = mesh_parameters_from_scenario(scenario, stage)
+    p, i, j = (x[0] for x in mesh_phase_series(np.array([pinion_angle_rad]), P))
+    k = stiffness_at_phase(p, P) * tooth_pair_factor(i, j, P)
+    if k <= 0:
+        raise ValueError(
+            f"stage {stage + 1}: the teeth in mesh at the start carry no load (stiffness factor 0): "
+            "start from rest"
+        )
+    st = scenario.stages[stage]
+    return force_N / k + st.mesh.backlash_um * 1e-6 - tooth_error_m(p, i, P)
 
 
 def initial_state(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
     """Initial coordinates and velocities of the scene's DOFs (docs/scenario.md, 'Initial state')."""
     scene = scenario.meta.scene
-    ndof = {"muller": 1, "two-wheel": 2, "one-stage": 4}[scene]
+    ndof = {"muller": 1, "two-wheel": 2}.get(scene, 2 * len(scenario.stages) + 2)
     if scenario.operation.initial_state == "rest":
         return np.zeros(ndof), np.zeros(ndof)
     op = steady_operating_point(scenario)
-    r2, w_p, w_w, delta0 = (
-        scenario.design.wheel.base_radius_m,
-        op["pinion_speed_rad_s"],
-        op["wheel_speed_rad_s"],
-        op["deflection_m"],
-    )
+    forces = op["mesh_force_N"]
+    st0 = scenario.stages[0]
     if scene == "muller":
-        return np.array([delta0]), np.zeros(1)
+        return np.array([static_deflection_m(scenario, 0, 0.0, forces[0])]), np.zeros(1)
     if scene == "two-wheel":
-        return np.array([0.0, -delta0 / r2]), np.array([w_p, w_w])
-    d = scenario.design
-    phi3 = -delta0 / r2
-    q = np.array(
-        [
-            op["pinion_torque_Nm"] / d.coupling.stiffness_Nm_per_rad,
-            0.0,
-            phi3,
-            phi3 - op["load_torque_Nm"] / d.output_shaft.stiffness_Nm_per_rad,
-        ]
-    )
-    return q, np.array([w_p, w_p, w_w, w_w])
+        delta0 = static_deflection_m(scenario, 0, 0.0, forces[0])
+        return (
+            np.array([0.0, -delta0 / st0.wheel.base_radius_m]),
+            np.array([op["pinion_speed_rad_s"][0], op["wheel_speed_rad_s"][0]]),
+        )
+    shafts = chain_shafts(scenario)
+    q, v = [], []
+    pinion = 0.0
+    for k, st in enumerate(scenario.stages):
+        delta = static_deflection_m(scenario, k, pinion, forces[k])
+        wheel = (st.pinion.base_radius_m * pinion - delta) / st.wheel.base_radius_m
+        q += [pinion, wheel]
+        v += [op["pinion_speed_rad_s"][k], op["wheel_speed_rad_s"][k]]
+        if k + 1 < len(scenario.stages):
+            pinion = wheel - op["pinion_torque_Nm"][k + 1] / shafts[k + 1].stiffness_Nm_per_rad
+    motor = op["pinion_torque_Nm"][0] / shafts[0].stiffness_Nm_per_rad
+    machine = q[-1] - op["load_torque_Nm"] / shafts[-1].stiffness_Nm_per_rad
+    return np.array([motor, *q, machine]), np.array([v[0], *v, v[-1]])
 
 
 def mesh_frequency_hz(scenario: Scenario, pinion_speed_rad_s: float) -> float:
     """Mesh frequency f_z = z1 w / (2 pi)."""
-    return scenario.design.pinion.teeth * pinion_speed_rad_s / (2 * math.pi)
+    return scenario.stages[0].pinion.teeth * pinion_speed_rad_s / (2 * math.pi)

@@ -26,7 +26,7 @@ class ModeSet:
     frequencies_hz: np.ndarray
     shapes: np.ndarray
     dof_names: list[str]
-    mean_mesh_stiffness_N_per_m: float | None = None
+    mean_mesh_stiffness_N_per_m: tuple[float, ...] = ()  # per mesh, at which the modes were computed
 
     def dominant_dof(self, mode: int) -> str:
         return self.dof_names[int(np.argmax(np.abs(self.shapes[:, mode])))]
@@ -44,17 +44,26 @@ def _eigen(mbs: exu.MainSystem) -> tuple[np.ndarray, np.ndarray]:
     return freqs, shapes
 
 
-def natural_frequencies(layout: TorsionalLayout, mesh_stiffness_N_per_m: float = 0.0) -> ModeSet:
-    """Natural frequencies of a torsional layout (any branched chain of inertias, shafts, meshes)."""
-    built = build_torsional(layout, modal_mesh_stiffness_N_per_m=mesh_stiffness_N_per_m, sensors=False)
+def natural_frequencies(
+    layout: TorsionalLayout, mesh_stiffness_N_per_m: float | list[float] | None = None
+) -> ModeSet:
+    """Natural frequencies of a torsional layout (any branched chain of inertias, shafts, meshes).
+
+    ``mesh_stiffness_N_per_m``: one line-of-action stiffness for all meshes or one per mesh; None
+    takes each mesh's exact mean k_z over its mesh period.
+    """
+    if mesh_stiffness_N_per_m is None:
+        mesh_stiffness_N_per_m = [mean_stiffness_N_per_m(m.parameters) for m in layout.meshes]
+    k = tuple(np.broadcast_to(np.asarray(mesh_stiffness_N_per_m, float), (len(layout.meshes),)))
+    built = build_torsional(layout, modal_mesh_stiffness_N_per_m=k, sensors=False)
     freqs, shapes = _eigen(built.mbs)
-    return ModeSet(freqs, shapes, built.dof_names, mesh_stiffness_N_per_m if layout.meshes else None)
+    return ModeSet(freqs, shapes, built.dof_names, k)
 
 
 def scene_modes(scenario: Scenario) -> ModeSet:
     """Modes of a scene at its mean mesh stiffness (healthy teeth)."""
-    k_mean = mean_stiffness_N_per_m(mesh_parameters_from_scenario(scenario))
     if scenario.meta.scene == "muller":
+        k_mean = mean_stiffness_N_per_m(mesh_parameters_from_scenario(scenario))
         SC = exu.SystemContainer()
         mbs = SC.AddSystem()
         n = mbs.AddNode(Node1D(referenceCoordinates=[0.0]))
@@ -66,8 +75,8 @@ def scene_modes(scenario: Scenario) -> ModeSet:
         )
         mbs.Assemble()
         freqs, shapes = _eigen(mbs)
-        return ModeSet(freqs, shapes, ["deflection"], k_mean)
-    return natural_frequencies(torsional_layout(scenario), k_mean)
+        return ModeSet(freqs, shapes, ["deflection"], (k_mean,))
+    return natural_frequencies(torsional_layout(scenario))
 
 
 def resonance_speeds_rad_s(modes: ModeSet, pinion_teeth: int, harmonics: int = 1) -> np.ndarray:

@@ -24,7 +24,7 @@ from ..physics.mesh import mesh_contact_series, mesh_parameters_from_scenario, m
 from ..physics.motor import pack_drive_parameters
 from ..result import Result
 from .build import BuiltSystem, build_muller, build_torsional
-from .layout import initial_state, mesh_frequency_hz, torsional_layout
+from .layout import gear_names, initial_state, mesh_frequency_hz, torsional_layout
 
 SOLVER_TYPES = {
     name: getattr(exu.DynamicSolverType, name) for name in ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")
@@ -225,22 +225,30 @@ def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
         "output_rate_hz": rate,
         "dof_names": built.dof_names,
         "rated_mesh_force_N": scenario.rated_mesh_force_N,
-        "pinion_teeth": scenario.design.pinion.teeth,
-        "wheel_teeth": scenario.design.wheel.teeth,
+        "pinion_teeth": scenario.stages[0].pinion.teeth,
+        "wheel_teeth": scenario.stages[0].wheel.teeth,
+        "stages": [
+            {
+                "pinion_teeth": st.pinion.teeth,
+                "wheel_teeth": st.wheel.teeth,
+                "rated_mesh_force_N": scenario.stage_rated_force_N(k),
+            }
+            for k, st in enumerate(scenario.stages)
+        ],
         "sources": list(scenario.meta.sources),
         "solver_statistics": stats,
     }
     return Result(time_s=t, signals=signals, meta=meta)
 
 
-def _mesh_signals(scenario: Scenario, pinion_angle, delta, delta_rate, P) -> dict[str, np.ndarray]:
+def _mesh_signals(pinion_angle, delta, delta_rate, P, rated_force_N: float) -> dict[str, np.ndarray]:
     F, T = mesh_contact_series(
         np.ascontiguousarray(pinion_angle), np.ascontiguousarray(delta), np.ascontiguousarray(delta_rate), P
     )
     p, i, j = mesh_phase_series(np.ascontiguousarray(pinion_angle), P)
     return {
         "mesh_force_N": F,
-        "kd": F / scenario.rated_mesh_force_N,
+        "kd": F / rated_force_N,
         "friction_force_N": T,
         "mesh_deflection_m": delta,
         "mesh_phase": p,
@@ -255,14 +263,22 @@ def _torsional_signals(scenario, names, t, q, v, a) -> dict[str, np.ndarray]:
         out[f"{name}_angle_rad"] = q[k]
         out[f"{name}_speed_rad_s"] = v[k]
         out[f"{name}_accel_rad_s2"] = a[k]
-    r1, r2 = scenario.design.pinion.base_radius_m, scenario.design.wheel.base_radius_m
-    ip, iw = names.index("pinion"), names.index("wheel")
-    P = mesh_parameters_from_scenario(scenario)
-    out.update(_mesh_signals(scenario, q[ip], r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw], P))
+    # Stage 1's mesh signals carry the plain names (mesh_force_N, kd, ...); later stages are prefixed
+    # stage_2_, stage_3_, ... and their K_d is relative to their own rated force.
+    for k, st in enumerate(scenario.stages):
+        pname, wname = gear_names(k)
+        ip, iw = names.index(pname), names.index(wname)
+        r1, r2 = st.pinion.base_radius_m, st.wheel.base_radius_m
+        P = mesh_parameters_from_scenario(scenario, k)
+        sig = _mesh_signals(
+            q[ip], r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw], P, scenario.stage_rated_force_N(k)
+        )
+        sig["mesh_frequency_hz"] = st.pinion.teeth * v[ip] / (2 * math.pi)
+        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        out.update({prefix + key: value for key, value in sig.items()})
     D = pack_drive_parameters(scenario)
     out["motor_torque_Nm"] = np.array([motor_torque_at(tk, w, D) for tk, w in zip(t, v[0], strict=True)])
     out["load_torque_Nm"] = np.array([load_torque_at(tk, D) for tk in t])
-    out["mesh_frequency_hz"] = scenario.design.pinion.teeth * v[ip] / (2 * math.pi)
     return out
 
 
@@ -276,9 +292,9 @@ def _muller_signals(scenario, t, x, xd, xdd) -> dict[str, np.ndarray]:
         "pinion_angle_rad": theta,
     }
     P = mesh_parameters_from_scenario(scenario, friction=False)
-    out.update(_mesh_signals(scenario, theta, x, xd, P))
+    out.update(_mesh_signals(theta, x, xd, P, scenario.rated_mesh_force_N))
     out["load_torque_Nm"] = np.array([load_torque_at(tk, D) for tk in t])
-    out["mesh_frequency_hz"] = np.gradient(theta, t) * scenario.design.pinion.teeth / (2 * math.pi)
+    out["mesh_frequency_hz"] = np.gradient(theta, t) * scenario.stages[0].pinion.teeth / (2 * math.pi)
     return out
 
 

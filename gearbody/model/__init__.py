@@ -19,6 +19,7 @@ from .scenario import (
     Scenario,
     Shaft,
     Solver,
+    Stage,
 )
 
 __all__ = [
@@ -38,6 +39,7 @@ __all__ = [
     "Scenario",
     "ScenarioError",
     "Shaft",
+    "Stage",
     "Solver",
     "dump_scenario",
     "load_scenario",

@@ -83,7 +83,11 @@ def load_scenario(
 
 def scenario_to_dict(scenario: Scenario) -> dict[str, Any]:
     """The resolved scenario as a nested dict (every default filled in)."""
-    return to_dict(scenario)
+    data = to_dict(scenario)
+    for key in ("stages", "shafts"):  # train-only lists: leave them out of single-stage scenes
+        if not data["design"].get(key):
+            data["design"].pop(key, None)
+    return data
 
 
 def dump_scenario(scenario: Scenario, path: str | Path) -> Path:

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from .params import ScenarioError, param
 
-SCENES = ("muller", "two-wheel", "one-stage")
+SCENES = ("muller", "two-wheel", "one-stage", "train")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -88,12 +88,16 @@ class Mesh:
 @dataclass(frozen=True, kw_only=True)
 class Design:
     motor: Motor
-    pinion: Gear
-    wheel: Gear
     machine: Machine
+    pinion: Gear | None = param(None, doc="pinion (single-stage scenes)")
+    wheel: Gear | None = param(None, doc="wheel (single-stage scenes)")
     mesh: Mesh = param(default_factory=Mesh)
     coupling: Shaft | None = param(None, doc="motor-pinion coupling (one-stage)")
     output_shaft: Shaft | None = param(None, doc="wheel-machine shaft (one-stage)")
+    stages: tuple[Stage, ...] = param((), doc="gear stages in power-flow order (scene 'train')")
+    shafts: tuple[Shaft, ...] = param(
+        (), doc="motor->stage 1, stage s->s+1, ..., last stage->machine ('train')"
+    )
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -156,6 +160,22 @@ class Condition:
     damaged_teeth: tuple[DamagedTooth, ...] = param((), doc="per-tooth stiffness factors")
 
 
+@dataclass(frozen=True, kw_only=True)
+class Stage:
+    """One parallel-axis gear stage of a train: its gears, mesh, error mode and damaged teeth."""
+
+    pinion: Gear
+    wheel: Gear
+    mesh: Mesh = param(default_factory=Mesh)
+    error_mode: ErrorMode = param(default_factory=ErrorMode)
+    damaged_teeth: tuple[DamagedTooth, ...] = param((), doc="per-tooth stiffness factors of this stage")
+
+    @property
+    def ratio(self) -> float:
+        """z2 / z1."""
+        return self.wheel.teeth / self.pinion.teeth
+
+
 SOLVER_METHODS = ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")
 
 
@@ -183,25 +203,54 @@ class Scenario:
 
     def __post_init__(self) -> None:
         d = self.design
-        if self.meta.scene == "one-stage":
-            for name in ("coupling", "output_shaft"):
-                if getattr(d, name) is None:
-                    raise ScenarioError(f"design.{name} is required for scene 'one-stage'")
-        pb1 = 2 * math.pi * d.pinion.base_radius_m / d.pinion.teeth
-        pb2 = 2 * math.pi * d.wheel.base_radius_m / d.wheel.teeth
-        if abs(pb2 / pb1 - 1) > 0.005:
-            raise ScenarioError(
-                f"design.wheel.base_radius_m = {d.wheel.base_radius_m}: base pitch 2 pi r_b / z = "
-                f"{pb2 * 1e3:.4f} mm differs from the pinion's {pb1 * 1e3:.4f} mm by more than 0.5 %; "
-                f"meshing gears need equal base pitches (r_b2 = r_b1 z2 / z1 = "
-                f"{d.pinion.base_radius_m * d.wheel.teeth / d.pinion.teeth:.6g} m)"
-            )
-        for t in self.condition.damaged_teeth:
-            z = getattr(d, t.gear).teeth
-            if t.tooth >= z:
+        if self.meta.scene == "train":
+            if (
+                d.pinion is not None
+                or d.wheel is not None
+                or d.coupling is not None
+                or d.output_shaft is not None
+            ):
                 raise ScenarioError(
-                    f"condition.damaged_teeth: tooth = {t.tooth} on the {t.gear}: must be < its {z} teeth"
+                    "a 'train' describes its gears in [[design.stages]] and its shafts in "
+                    "[[design.shafts]]; remove design.pinion/wheel/coupling/output_shaft"
                 )
+            if not d.stages:
+                raise ScenarioError("design.stages: a 'train' needs at least one [[design.stages]] entry")
+            if len(d.shafts) != len(d.stages) + 1:
+                raise ScenarioError(
+                    f"design.shafts has {len(d.shafts)} entries: a train of {len(d.stages)} "
+                    f"stage(s) needs {len(d.stages) + 1} (motor->stage 1, ..., last stage->machine)"
+                )
+        else:
+            if d.stages or d.shafts:
+                raise ScenarioError(
+                    f"design.stages / design.shafts belong to scene 'train', not {self.meta.scene!r}"
+                )
+            for name in ("pinion", "wheel"):
+                if getattr(d, name) is None:
+                    raise ScenarioError(f"design.{name} is required for scene {self.meta.scene!r}")
+            if self.meta.scene == "one-stage":
+                for name in ("coupling", "output_shaft"):
+                    if getattr(d, name) is None:
+                        raise ScenarioError(f"design.{name} is required for scene 'one-stage'")
+        for k, stage in enumerate(self.stages):
+            where = f"design.stages[{k}]." if self.meta.scene == "train" else "design."
+            pb1 = 2 * math.pi * stage.pinion.base_radius_m / stage.pinion.teeth
+            pb2 = 2 * math.pi * stage.wheel.base_radius_m / stage.wheel.teeth
+            if abs(pb2 / pb1 - 1) > 0.005:
+                raise ScenarioError(
+                    f"{where}wheel.base_radius_m = {stage.wheel.base_radius_m}: base pitch 2 pi r_b / z = "
+                    f"{pb2 * 1e3:.4f} mm differs from the pinion's {pb1 * 1e3:.4f} mm by more than 0.5 %; "
+                    f"meshing gears need equal base pitches (r_b2 = r_b1 z2 / z1 = "
+                    f"{stage.pinion.base_radius_m * stage.wheel.teeth / stage.pinion.teeth:.6g} m)"
+                )
+            for t in stage.damaged_teeth:
+                z = getattr(stage, t.gear).teeth
+                if t.tooth >= z:
+                    where_t = f"design.stages[{k}]." if self.meta.scene == "train" else "condition."
+                    raise ScenarioError(
+                        f"{where_t}damaged_teeth: tooth = {t.tooth} on the {t.gear}: must be < its {z} teeth"
+                    )
         if self.solver.output_rate_hz * self.operation.t_end_s < 2:
             raise ScenarioError(
                 f"solver.output_rate_hz = {self.solver.output_rate_hz}: gives fewer than 2 "
@@ -210,11 +259,36 @@ class Scenario:
 
     # -- derived quantities used everywhere ------------------------------------------------
     @property
+    def stages(self) -> tuple[Stage, ...]:
+        """The gear stages in power-flow order; a single-stage scene is one stage built from
+        design.pinion/wheel/mesh, production.error_mode and condition.damaged_teeth."""
+        d = self.design
+        if self.meta.scene == "train":
+            return d.stages
+        return (
+            Stage(
+                pinion=d.pinion,
+                wheel=d.wheel,
+                mesh=d.mesh,
+                error_mode=self.production.error_mode,
+                damaged_teeth=self.condition.damaged_teeth,
+            ),
+        )
+
+    @property
     def gear_ratio(self) -> float:
-        """Wheel to pinion ratio z2/z1 (= r2/r1 for a standard pair)."""
-        return self.design.wheel.teeth / self.design.pinion.teeth
+        """Overall ratio, product of z2/z1 over the stages."""
+        return math.prod(s.ratio for s in self.stages)
+
+    def stage_rated_force_N(self, stage: int) -> float:
+        """F_rated,s: the rated machine torque passed upstream through the base radii,
+        F_N = M_rated / r_w,N and F_s = F_s+1 r_p,s+1 / r_w,s (static equilibrium, no friction)."""
+        force = self.design.machine.rated_torque_Nm / self.stages[-1].wheel.base_radius_m
+        for k in range(len(self.stages) - 1, stage, -1):
+            force *= self.stages[k].pinion.base_radius_m / self.stages[k - 1].wheel.base_radius_m
+        return force
 
     @property
     def rated_mesh_force_N(self) -> float:
-        """F_rated = rated machine torque / wheel base radius."""
-        return self.design.machine.rated_torque_Nm / self.design.wheel.base_radius_m
+        """F_rated of the first stage (the only one in single-stage scenes)."""
+        return self.stage_rated_force_N(0)

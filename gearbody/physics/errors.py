@@ -5,15 +5,17 @@ from __future__ import annotations
 import numpy as np
 
 
-def tooth_random_factors(teeth: int, seed: int) -> np.ndarray:
-    """l_i in [0, 1), one per pinion tooth: ``numpy.random.default_rng(seed).random(teeth)``.
+def tooth_random_factors(teeth: int, seed: int, stage: int = 0) -> np.ndarray:
+    """l_i in [0, 1), one per pinion tooth of a stage (0-based, power-flow order).
 
-    This exact draw is part of the scenario format (docs/scenario.md): the same seed gives the same
-    teeth in every run, on every machine.
+    ``numpy.random.default_rng(seed).random(teeth)`` for stage 0 and
+    ``numpy.random.default_rng([seed, stage]).random(teeth)`` after it. This exact draw is part of the
+    scenario format (docs/scenario.md): the same seed gives the same teeth in every run, on every machine.
     """
-    return np.random.default_rng(seed).random(teeth)
+    rng = np.random.default_rng(seed) if stage == 0 else np.random.default_rng([seed, stage])
+    return rng.random(teeth)
 
 
-def tooth_error_depths_m(e_um: float, r: float, teeth: int, seed: int) -> np.ndarray:
+def tooth_error_depths_m(e_um: float, r: float, teeth: int, seed: int, stage: int = 0) -> np.ndarray:
     """Per-tooth maximum error e_i = [1 - r (1 - l_i)] e of eq. (6), in metres."""
-    return (1.0 - r * (1.0 - tooth_random_factors(teeth, seed))) * e_um * 1e-6
+    return (1.0 - r * (1.0 - tooth_random_factors(teeth, seed, stage))) * e_um * 1e-6

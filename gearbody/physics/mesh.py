@@ -81,17 +81,18 @@ def pack_mesh_parameters(
     return np.concatenate([head, e, f, g, tp, tk])
 
 
-def mesh_parameters_from_scenario(scenario, *, friction: bool = True) -> np.ndarray:
-    """Packed mesh parameters of a :class:`~gearbody.model.Scenario` (the engine's only entry)."""
-    d, mesh, em = scenario.design, scenario.design.mesh, scenario.production.error_mode
-    z1, z2 = d.pinion.teeth, d.wheel.teeth
+def mesh_parameters_from_scenario(scenario, stage: int = 0, *, friction: bool = True) -> np.ndarray:
+    """Packed mesh parameters of one stage (0-based) of a :class:`~gearbody.model.Scenario`."""
+    st = scenario.stages[stage]
+    mesh, em = st.mesh, st.error_mode
+    z1, z2 = st.pinion.teeth, st.wheel.teeth
     f, g = np.ones(z1), np.ones(z2)
-    for tooth in scenario.condition.damaged_teeth:
+    for tooth in st.damaged_teeth:
         (f if tooth.gear == "pinion" else g)[tooth.tooth] *= tooth.stiffness_factor
     table = mesh.stiffness_profile == "table"
     return pack_mesh_parameters(
-        r1_m=d.pinion.base_radius_m,
-        r2_m=d.wheel.base_radius_m,
+        r1_m=st.pinion.base_radius_m,
+        r2_m=st.wheel.base_radius_m,
         z1=z1,
         z2=z2,
         stiffness_single_N_per_m=mesh.stiffness_single_N_per_m,
@@ -103,7 +104,7 @@ def mesh_parameters_from_scenario(scenario, *, friction: bool = True) -> np.ndar
         pitch_point_phase=mesh.pitch_point_phase,
         pressure_angle_rad=math.radians(mesh.pressure_angle_deg),
         error_a=em.a,
-        error_depths_m=tooth_error_depths_m(em.e_um, em.r, z1, scenario.meta.seed),
+        error_depths_m=tooth_error_depths_m(em.e_um, em.r, z1, scenario.meta.seed, stage),
         pinion_factors=f,
         wheel_factors=g,
         table_phase=np.array(mesh.table_phase) if table else None,
@@ -147,6 +148,12 @@ def error_shape(p: float, a: float) -> float:
 
 
 @njit(cache=True)
+def tooth_error_m(p: float, i: int, P: np.ndarray) -> float:
+    """Error E of pinion tooth i's pair at mesh phase p, m: e_i times the triangular shape."""
+    return P[I_HEADER + i] * error_shape(p, P[I_A])
+
+
+@njit(cache=True)
 def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float, P: np.ndarray):
     """Normal mesh force F (N, elastic + damping), friction force T (N) and arms rho_1, rho_2 (m).
 
@@ -161,7 +168,7 @@ def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float,
     j = int(n % z2)
     factor = tooth_pair_factor(i, j, P)
     k = stiffness_at_phase(p, P) * factor
-    d = delta_m + P[I_HEADER + i] * error_shape(p, P[I_A])
+    d = delta_m + tooth_error_m(p, i, P)
     lu = P[I_LU]
     if d > lu:
         F = k * (d - lu) + P[I_CZ] * factor * delta_rate_m_s
