@@ -99,3 +99,16 @@ def test_steady_start_on_a_broken_tooth_is_refused_with_a_hint():
     with pytest.raises(SimulationError, match="carry no load"):
         broken = 'condition.damaged_teeth=[{gear="pinion",tooth=0,stiffness_factor=0.0}]'
         simulate(steady("one-stage", broken))
+
+
+def test_steady_start_subtracts_the_error_in_mesh():
+    """a = 0 puts the full error at p = 0: the steady start must still be an equilibrium."""
+    sc = steady(
+        "one-stage",
+        "production.error_mode={a=0.0,e_um=10.0,r=0.0}",
+        "condition.friction_coefficient=0",
+        "design.mesh.stiffness_double_N_per_m=1.2e9",
+        t_end=0.0004,
+    )
+    r = simulate(sc)
+    assert abs(r.kd[0] - 1.0) < 1e-9

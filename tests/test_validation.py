@@ -32,5 +32,5 @@ def test_comparison_detects_a_model_difference():
 def test_validate_command_prints_a_table_and_reports_failure(capsys):
     lines = []
     assert run_validation(["two-wheel"], short=True, echo=lines.append)
-    assert any(line.startswith("two-wheel  steady") for line in lines)
+    assert any(line.split()[:2] == ["two-wheel", "steady"] for line in lines)
     assert not run_validation(["two-wheel"], short=True, tolerance_percent=1e-9, echo=lines.append)

@@ -1,4 +1,5 @@
-"""Independent reference model for the gearbody scenes ``muller``, ``two-wheel`` and ``one-stage``.
+"""Independent reference model for the gearbody scenes ``muller``, ``two-wheel``, ``one-stage`` and
+``train`` (a chain of N >= 1 stages, section "Gear trains" of ``docs/scenario.md``).
 
 Written directly from ``docs/scenario.md`` (the contract) as a first-order ODE system and integrated
 with :func:`scipy.integrate.solve_ivp`.  It deliberately shares no code with ``gearbody``.
@@ -28,6 +29,16 @@ points of the speed and load profiles are also segment boundaries.
 The mesh force at the output times is evaluated from the (dense-output) states at those times with
 the very same function (``_mesh_force``) that the right-hand side uses, in the mode that was active
 when the sample time was reached.
+
+Gear trains
+-----------
+Each stage's mesh is a :class:`_Mesh` built from the one-stage-shaped :func:`stage_view` of that
+stage (its own pinion/wheel, stiffness profile, damping, backlash, error mode with its own random
+draw, damaged teeth, and the rated torque referred to its wheel), so the helpers above serve trains
+unchanged.  Every mesh has its own locked mode ``(n_s, k_s, c_s)``; a segment of the integration is
+locked in all of them at once and ends at the first boundary event of *any* mesh (the events of all
+meshes are passed to ``solve_ivp`` together, and the sub-step scan covers all of them).  For N = 1
+the train right-hand side performs the same floating-point operations as the one-stage scene.
 """
 
 from __future__ import annotations
@@ -61,6 +72,10 @@ __all__ = [
     "friction_moments",
     "initial_state",
     "phase_breakpoints",
+    "is_train",
+    "train_stages",
+    "stage_F_rated",
+    "stage_view",
 ]
 
 TWO_PI = 2.0 * math.pi
@@ -79,9 +94,75 @@ def load_scenario(path) -> dict:
 
 
 def F_rated(scenario: dict) -> float:
-    """F_rated = machine.rated_torque_Nm / r2."""
+    """F_rated = machine.rated_torque_Nm / r2 (train: F_rated,0 of the first stage)."""
+    if is_train(scenario):
+        return float(stage_F_rated(scenario)[0])
     d = scenario["design"]
     return float(d["machine"]["rated_torque_Nm"]) / float(d["wheel"]["base_radius_m"])
+
+
+# ----------------------------------------------------------------------------------------------
+# Gear trains (scene "train")
+# ----------------------------------------------------------------------------------------------
+def is_train(scenario: dict) -> bool:
+    return scenario["meta"]["scene"] == "train"
+
+
+def train_stages(scenario: dict) -> list[dict]:
+    """design.stages of a train, checked: N >= 1 stages and exactly N + 1 shafts."""
+    stages = list(scenario["design"]["stages"])
+    n_shafts = len(scenario["design"]["shafts"])
+    if len(stages) < 1:
+        raise ValueError("a train needs at least one stage")
+    if n_shafts != len(stages) + 1:
+        raise ValueError(f"a train of {len(stages)} stages needs {len(stages) + 1} shafts, got {n_shafts}")
+    return stages
+
+
+def stage_F_rated(scenario: dict) -> np.ndarray:
+    """Rated force per stage (s = 0 .. N-1 here): the rated machine torque passed upstream through the
+    base radii, F_rated,N = rated_torque_Nm / r_wN, F_rated,s = F_rated,s+1 r_p,s+1 / r_ws.
+
+    Any other scene: the single F_rated in an array of length 1.
+    """
+    if not is_train(scenario):
+        return np.array([F_rated(scenario)])
+    stages = train_stages(scenario)
+    r_p = [float(st["pinion"]["base_radius_m"]) for st in stages]
+    r_w = [float(st["wheel"]["base_radius_m"]) for st in stages]
+    N = len(stages)
+    out = np.empty(N)
+    out[N - 1] = float(scenario["design"]["machine"]["rated_torque_Nm"]) / r_w[N - 1]
+    for s in range(N - 2, -1, -1):
+        out[s] = out[s + 1] * r_p[s + 1] / r_w[s]
+    return out
+
+
+def stage_view(scenario: dict, s: int) -> dict:
+    """Stage s of a train as a one-stage-shaped scenario dict for the mesh helpers
+    (tooth_factors, tooth_error_amplitudes, mesh_force_literal, friction_moments, F_rated, ...).
+
+    meta.scene becomes "train-stage" and meta.stage_index = s selects the random draw;
+    production.error_mode and condition.damaged_teeth are the stage's own, condition.friction_coefficient
+    the common one; machine.rated_torque_Nm is the rated torque on this stage's wheel, F_rated,s r_ws,
+    so that F_rated(view) = F_rated,s (to round-off).
+    """
+    st = train_stages(scenario)[s]
+    m_wheel = float(stage_F_rated(scenario)[s]) * float(st["wheel"]["base_radius_m"])
+    return {
+        "meta": {**scenario["meta"], "scene": "train-stage", "stage_index": s},
+        "design": {
+            "pinion": st["pinion"],
+            "wheel": st["wheel"],
+            "mesh": st["mesh"],
+            "machine": {"rated_torque_Nm": m_wheel},
+        },
+        "production": {"error_mode": st["error_mode"]},
+        "condition": {
+            "friction_coefficient": scenario["condition"]["friction_coefficient"],
+            "damaged_teeth": st.get("damaged_teeth", []),
+        },
+    }
 
 
 def _profile_arrays(profile: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -134,16 +215,19 @@ def steady_slip(m_p: float, motor: dict) -> float:
     return sb * (mb - math.sqrt(mb * mb - m_p * m_p)) / m_p
 
 
-def random_l(seed: int, z1: int) -> np.ndarray:
-    """l = numpy.random.default_rng(seed).random(z1)."""
-    return np.random.default_rng(seed).random(z1)
+def random_l(seed: int, z1: int, stage: int = 0) -> np.ndarray:
+    """l = numpy.random.default_rng(seed).random(z1) for stage 0 (and every one-mesh scene),
+    l = numpy.random.default_rng([seed, stage]).random(z1) for train stages >= 1."""
+    if stage == 0:
+        return np.random.default_rng(seed).random(z1)
+    return np.random.default_rng([seed, stage]).random(z1)
 
 
 def tooth_error_amplitudes(scenario: dict) -> np.ndarray:
-    """e_i = [1 - r (1 - l[i])] e in metres, one per pinion tooth."""
+    """e_i = [1 - r (1 - l[i])] e in metres, one per pinion tooth (train stage: meta.stage_index)."""
     em = scenario["production"]["error_mode"]
     z1 = int(scenario["design"]["pinion"]["teeth"])
-    l_rand = random_l(int(scenario["meta"]["seed"]), z1)
+    l_rand = random_l(int(scenario["meta"]["seed"]), z1, int(scenario["meta"].get("stage_index", 0)))
     return (1.0 - float(em["r"]) * (1.0 - l_rand)) * float(em["e_um"]) * 1e-6
 
 
@@ -245,6 +329,8 @@ def friction_moments(scenario: dict, p, F) -> dict:
 def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     """Initial coordinates and velocities for initial_state "rest" | "steady"."""
     scene = scenario["meta"]["scene"]
+    if scene == "train":
+        return _train_initial_state(scenario)
     n_dof = {"muller": 1, "two-wheel": 2, "one-stage": 4}[scene]
     kind = scenario["operation"]["initial_state"]
     q0 = np.zeros(n_dof)
@@ -263,7 +349,9 @@ def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     M_p = F0 * r1
     f, g = tooth_factors(scenario)
     k0 = float(base_stiffness(0.0, mesh)) * f[0] * g[0]
-    delta0 = F0 / k0 + lu if F0 != 0.0 else 0.0
+    E0 = float(error_shape(0.0, float(scenario["production"]["error_mode"]["a"]),
+                           tooth_error_amplitudes(scenario)[0]))  # non-zero only for a = 0
+    delta0 = F0 / k0 + lu - E0 if F0 != 0.0 else 0.0
     if scene == "muller":
         q0[0] = delta0
         return q0, v0
@@ -280,6 +368,68 @@ def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     phi3 = -delta0 / r2
     q0[:] = [M_p / k1, 0.0, phi3, phi3 - M_L / k2]
     v0[:] = [w, w, w * r1 / r2, w * r1 / r2]
+    return q0, v0
+
+
+def _train_initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Initial state of a train (section "Gear trains" of docs/scenario.md), stage by stage."""
+    stages = train_stages(scenario)
+    N = len(stages)
+    q0 = np.zeros(2 * N + 2)
+    v0 = np.zeros(2 * N + 2)
+    kind = scenario["operation"]["initial_state"]
+    if kind == "rest":
+        return q0, v0
+    if kind != "steady":
+        raise ValueError(f"unknown initial_state {kind!r}")
+    d_ = scenario["design"]
+    shaft_k = [float(sh["stiffness_Nm_per_rad"]) for sh in d_["shafts"]]
+    load0 = float(profile_value(0.0, scenario["operation"]["load_profile"]))
+    M_L = float(d_["machine"]["rated_torque_Nm"]) * load0
+    r_p = [float(st["pinion"]["base_radius_m"]) for st in stages]
+    r_w = [float(st["wheel"]["base_radius_m"]) for st in stages]
+    z_p = [int(st["pinion"]["teeth"]) for st in stages]
+    z_w = [int(st["wheel"]["teeth"]) for st in stages]
+    F = [load0 * Fr for Fr in stage_F_rated(scenario)]  # F_s = f F_rated,s
+    pinion_torque = [F[s] * r_p[s] for s in range(N)]
+    # speeds: motor = pinion 1 from the Kloss stable branch, wheel = pinion r_p / r_w, next pinion = wheel
+    motor = d_["motor"]
+    wsr = float(motor["synchronous_speed_rad_s"])
+    ws0 = wsr * float(profile_value(0.0, scenario["operation"]["speed_profile"]))
+    w = ws0 - steady_slip(pinion_torque[0], motor) * wsr
+    v0[0] = w
+    for s in range(N):
+        v0[1 + 2 * s] = w
+        w = w * r_p[s] / r_w[s]
+        v0[2 + 2 * s] = w
+    v0[2 * N + 1] = w
+    # angles: pinion 1 = 0, then stage by stage in power-flow order
+    pinion = 0.0
+    for s in range(N):
+        view = stage_view(scenario, s)
+        mesh = view["design"]["mesh"]
+        u = pinion * z_p[s] / TWO_PI
+        n = math.floor(u)
+        p = u - n
+        i, j = n % z_p[s], n % z_w[s]
+        f, g = tooth_factors(view)
+        k = float(base_stiffness(p, mesh)) * f[i] * g[j]
+        a = float(view["production"]["error_mode"]["a"])
+        E = float(error_shape(p, a, tooth_error_amplitudes(view)[i]))
+        lu = float(mesh["backlash_um"]) * 1e-6
+        if F[s] == 0.0:
+            delta = 0.0
+        elif k == 0.0:
+            raise ValueError(f"steady start: stage {s} meshes with zero stiffness at its initial angle")
+        else:
+            delta = F[s] / k + lu - E
+        q0[1 + 2 * s] = pinion
+        wheel = (r_p[s] * pinion - delta) / r_w[s]
+        q0[2 + 2 * s] = wheel
+        if s + 1 < N:
+            pinion = wheel - pinion_torque[s + 1] / shaft_k[s + 1]
+    q0[0] = q0[1] + pinion_torque[0] / shaft_k[0]
+    q0[2 * N + 1] = q0[2 * N] - M_L / shaft_k[N]
     return q0, v0
 
 
@@ -315,14 +465,14 @@ def _mesh_force(mc: tuple, p, delta, delta_dot):
     return fg * (kA + kS * (p - bA)) * (d - c * lu) + Cf * delta_dot
 
 
-class _Model:
-    """Constants of one resolved scenario, plus the per-mode constants."""
+class _Mesh:
+    """Constants of one gear mesh, plus its per-mode constants.
 
-    def __init__(self, sc: dict):
-        self.sc = sc
-        self.scene = sc["meta"]["scene"]
-        if self.scene not in ("muller", "two-wheel", "one-stage"):
-            raise ValueError(f"unknown scene {self.scene!r}")
+    ``sc`` is a one-stage-shaped scenario dict: a whole ``muller`` / ``two-wheel`` / ``one-stage``
+    scenario or the :func:`stage_view` of one stage of a train (then ``Frated`` = F_rated,s exactly).
+    """
+
+    def __init__(self, sc: dict, Frated: float | None = None):
         d_ = sc["design"]
         self.z1 = int(d_["pinion"]["teeth"])
         self.z2 = int(d_["wheel"]["teeth"])
@@ -335,11 +485,12 @@ class _Model:
         self.ppp = float(mesh["pitch_point_phase"])
         self.tan_a = math.tan(math.radians(float(mesh["pressure_angle_deg"])))
         self.pb = TWO_PI * self.r1 / self.z1
-        self.mu = float(sc["condition"]["friction_coefficient"]) if self.scene != "muller" else 0.0
+        muller = sc["meta"]["scene"] == "muller"
+        self.mu = float(sc["condition"]["friction_coefficient"]) if not muller else 0.0
         self.a = float(sc["production"]["error_mode"]["a"])
         self.f, self.g = tooth_factors(sc)
         self.e_amp = tooth_error_amplitudes(sc)
-        self.Frated = F_rated(sc)
+        self.Frated = F_rated(sc) if Frated is None else float(Frated)
         # phase intervals
         b = phase_breakpoints(sc)
         self.bA = b
@@ -360,28 +511,8 @@ class _Model:
                 Ea, Eb = 1.0 / (1.0 - self.a), -1.0 / (1.0 - self.a)
             s = 1.0 if mid < self.ppp else -1.0
             self.iv.append((kA, kS, Ea, Eb, s))
-        # motor / shafts / inertias
-        mot = d_["motor"]
-        self.wsr = float(mot["synchronous_speed_rad_s"])
-        self.Mb = float(mot["breakdown_torque_Nm"])
-        self.sb = float(mot["breakdown_slip"])
-        self.Is = float(mot["inertia_kg_m2"])
-        self.I1 = float(d_["pinion"]["inertia_kg_m2"])
-        self.I2 = float(d_["wheel"]["inertia_kg_m2"])
-        self.Im = float(d_["machine"]["inertia_kg_m2"])
-        self.Mrated = float(d_["machine"]["rated_torque_Nm"])
-        # shafts exist only in the one-stage system (two-wheel: rigid shafts, keys absent)
-        coupling, shaft = d_.get("coupling", {}), d_.get("output_shaft", {})
-        self.k1 = float(coupling.get("stiffness_Nm_per_rad", 0.0))
-        self.C1 = float(coupling.get("damping_Nms_per_rad", 0.0))
-        self.k2 = float(shaft.get("stiffness_Nm_per_rad", 0.0))
-        self.C2 = float(shaft.get("damping_Nms_per_rad", 0.0))
-        self.m_red = reduced_mass(sc)
-        op = sc["operation"]
-        self.speed_prof = op["speed_profile"]
-        self.load_prof = op["load_profile"]
-        self.n_dof = {"muller": 1, "two-wheel": 2, "one-stage": 4}[self.scene]
         # scales for the default absolute tolerance
+        self.m_red = reduced_mass(sc)
         kmax = max(float(np.max(base_stiffness(np.linspace(0, 1, 201), mesh))), 1.0)
         self.defl_scale = max(self.Frated / kmax, 1e-7)
         self.omega_n = math.sqrt(kmax / self.m_red)
@@ -412,6 +543,47 @@ class _Model:
         if d < -lu or (d == -lu and d_dot < 0):
             return -1
         return 0
+
+    def step_phase(self, n: int, k: int, step: int) -> tuple[int, int]:
+        """Phase mode after crossing one interval boundary upwards (+1) or downwards (-1)."""
+        k += step
+        if k >= self.K:
+            k, n = 0, n + 1
+        elif k < 0:
+            k, n = self.K - 1, n - 1
+        return n, k
+
+
+class _Model(_Mesh):
+    """Constants of one resolved single-mesh scenario (muller, two-wheel, one-stage)."""
+
+    def __init__(self, sc: dict):
+        self.sc = sc
+        self.scene = sc["meta"]["scene"]
+        if self.scene not in ("muller", "two-wheel", "one-stage"):
+            raise ValueError(f"unknown scene {self.scene!r}")
+        super().__init__(sc)
+        d_ = sc["design"]
+        # motor / shafts / inertias
+        mot = d_["motor"]
+        self.wsr = float(mot["synchronous_speed_rad_s"])
+        self.Mb = float(mot["breakdown_torque_Nm"])
+        self.sb = float(mot["breakdown_slip"])
+        self.Is = float(mot["inertia_kg_m2"])
+        self.I1 = float(d_["pinion"]["inertia_kg_m2"])
+        self.I2 = float(d_["wheel"]["inertia_kg_m2"])
+        self.Im = float(d_["machine"]["inertia_kg_m2"])
+        self.Mrated = float(d_["machine"]["rated_torque_Nm"])
+        # shafts exist only in the one-stage system (two-wheel: rigid shafts, keys absent)
+        coupling, shaft = d_.get("coupling", {}), d_.get("output_shaft", {})
+        self.k1 = float(coupling.get("stiffness_Nm_per_rad", 0.0))
+        self.C1 = float(coupling.get("damping_Nms_per_rad", 0.0))
+        self.k2 = float(shaft.get("stiffness_Nm_per_rad", 0.0))
+        self.C2 = float(shaft.get("damping_Nms_per_rad", 0.0))
+        op = sc["operation"]
+        self.speed_prof = op["speed_profile"]
+        self.load_prof = op["load_profile"]
+        self.n_dof = {"muller": 1, "two-wheel": 2, "one-stage": 4}[self.scene]
 
     # -- kinematics of the mesh per scene (u, delta, delta_dot) ------------------------------
     def kin(self, t, y, theta):
@@ -632,6 +804,306 @@ def _scan_missed_events(sol, events: list, t0: float, t1: float, n_sub: int = 16
     return best
 
 
+class _Train:
+    """Constants of a resolved train scenario (N stages, 2N + 2 torsional coordinates).
+
+    Coordinates ``[motor, pinion_1, wheel_1, ..., pinion_N, wheel_N, machine]``: stage s (0-based
+    here) has its pinion at index 1 + 2s and its wheel at 2 + 2s, and shaft j joins the coordinates
+    2j and 2j + 1 (shaft 0: motor - pinion_1, shaft s: wheel_s - pinion_(s+1), shaft N: wheel_N -
+    machine).  Each mesh is a :class:`_Mesh` built from its :func:`stage_view`.
+    """
+
+    def __init__(self, sc: dict):
+        self.sc = sc
+        stages = train_stages(sc)
+        self.N = len(stages)
+        self.n_dof = 2 * self.N + 2
+        self.meshes = [_Mesh(stage_view(sc, s), Fr) for s, Fr in enumerate(stage_F_rated(sc))]
+        self.ip = [1 + 2 * s for s in range(self.N)]
+        self.iw = [2 + 2 * s for s in range(self.N)]
+        d_ = sc["design"]
+        self.shaft_k = [float(sh["stiffness_Nm_per_rad"]) for sh in d_["shafts"]]
+        self.shaft_C = [float(sh["damping_Nms_per_rad"]) for sh in d_["shafts"]]
+        mot = d_["motor"]
+        self.wsr = float(mot["synchronous_speed_rad_s"])
+        self.Mb = float(mot["breakdown_torque_Nm"])
+        self.sb = float(mot["breakdown_slip"])
+        inertia = [float(mot["inertia_kg_m2"])]
+        for st in stages:
+            inertia += [float(st["pinion"]["inertia_kg_m2"]), float(st["wheel"]["inertia_kg_m2"])]
+        inertia.append(float(d_["machine"]["inertia_kg_m2"]))
+        self.inertia = inertia
+        self.Mrated = float(d_["machine"]["rated_torque_Nm"])
+        self.Frated = np.array([m.Frated for m in self.meshes])
+        op = sc["operation"]
+        self.speed_prof = op["speed_profile"]
+        self.load_prof = op["load_profile"]
+
+    # -- per-mesh kinematics (u, delta, delta_dot); y may be one state or states in columns -----
+    def kin(self, s: int, y):
+        m, ip, iw, nd = self.meshes[s], self.ip[s], self.iw[s], self.n_dof
+        return y[ip] * m.cz, m.r1 * y[ip] - m.r2 * y[iw], m.r1 * y[nd + ip] - m.r2 * y[nd + iw]
+
+    def deflection(self, s: int, n: int, k: int, y) -> tuple[float, float]:
+        """d = delta + E of stage s in phase mode (n, k), and its rate."""
+        u, delta, ddot = self.kin(s, y)
+        _, _, _, _, e_i, Ea, Eb, *_ = self.meshes[s].mode_consts(n, k, 0)
+        return delta + e_i * (Ea + Eb * (u - n)), ddot
+
+    def initial_modes(self, y) -> list[list[int]]:
+        modes = []
+        for s, m in enumerate(self.meshes):
+            u, _, _ = self.kin(s, y)
+            n, k = m.phase_mode(float(u), float(y[self.n_dof + self.ip[s]]) * m.cz)
+            d, dd = self.deflection(s, n, k, y)
+            modes.append([n, k, m.contact_mode(float(d), float(dd))])
+        return modes
+
+    # -- right-hand side in locked modes -------------------------------------------------------
+    def make_rhs(self, modes: list, chunk: dict):
+        """First-order right-hand side with every mesh locked in its mode; also returns the per-mesh
+        mode constants (for the outputs)."""
+        mcs = []
+        stage_data = []
+        for s, (n, k, c) in enumerate(modes):
+            m = self.meshes[s]
+            mc = m.mode_consts(n, k, c)
+            mcs.append(mc)
+            stage_data.append(
+                (
+                    self.ip[s],
+                    self.iw[s],
+                    m.r1,
+                    m.r2,
+                    m.cz,
+                    float(n),
+                    mc,
+                    m.mu * m.iv[k][4],
+                    m.ppp,
+                    m.pb,
+                    m.r1 * m.tan_a,
+                    m.r2 * m.tan_a,
+                )
+            )
+        shafts = [(2 * j, 2 * j + 1, self.shaft_k[j], self.shaft_C[j]) for j in range(self.N + 1)]
+        ta, sa, ss, la, ls = chunk["ta"], chunk["sa"], chunk["ss"], chunk["la"], chunk["ls"]
+        wsr, Mb, sb = self.wsr, self.Mb, self.sb
+        sbsq = sb * sb
+        Mrated = self.Mrated
+        nd = self.n_dof
+        Is, Im = self.inertia[0], self.inertia[-1]
+        Ip = self.inertia[1:-1:2]
+        Iw = self.inertia[2:-1:2]
+        mesh = _mesh_force
+        array = np.array
+
+        def rhs(t, y):
+            yl = y.tolist()
+            q, v = yl[:nd], yl[nd:]
+            tau = t - ta
+            # shaft moments S_j = k_j (q_a - q_b) + C_j (v_a - v_b), j = 0 .. N
+            S = [kj * (q[a] - q[b]) + Cj * (v[a] - v[b]) for a, b, kj, Cj in shafts]
+            slip = (wsr * (sa + ss * tau) - v[0]) / wsr
+            Ms = 2.0 * Mb * sb * slip / (slip * slip + sbsq)
+            Mr = Mrated * (la + ls * tau)
+            acc = [(Ms - S[0]) / Is]  # motor: I_s phi_m'' = M_s - S_0
+            for s, (ip, iw, r1, r2, cz, nf, mc, mus, ppp, pb, r1tan, r2tan) in enumerate(stage_data):
+                p = q[ip] * cz - nf
+                F = mesh(mc, p, r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw])
+                T = mus * abs(F)
+                qq = (p - ppp) * pb
+                # I_ps phi_ps'' = S_{s-1} - r_ps F_s + M_zt1,s;  I_ws phi_ws'' = r_ws F_s - M_zt2,s - S_s
+                acc.append((S[s] - r1 * F + T * (r1tan + qq)) / Ip[s])
+                acc.append((r2 * F - T * (r2tan - qq) - S[s + 1]) / Iw[s])
+            acc.append((S[-1] - Mr) / Im)  # machine: I_m phi_M'' = S_N - M_r
+            return array(v + acc)
+
+        return rhs, mcs
+
+    # -- events --------------------------------------------------------------------------------
+    def make_events(self, modes: list, mcs: list):
+        """Terminal events leaving the locked modes of all meshes; actions[m] = (stage, kind, value)."""
+        events, actions = [], []
+        for s, (n, k, c) in enumerate(modes):
+            m = self.meshes[s]
+            ip, iw, cz, r1, r2 = self.ip[s], self.iw[s], m.cz, m.r1, m.r2
+            lo = n + float(m.bA[k]) - _ETA_U
+            hi = n + float(m.bB[k]) + _ETA_U
+
+            def ev_up(t, y, ip=ip, cz=cz, hi=hi):
+                return y[ip] * cz - hi
+
+            def ev_down(t, y, ip=ip, cz=cz, lo=lo):
+                return y[ip] * cz - lo
+
+            ev_up.terminal, ev_up.direction = True, 1.0
+            ev_down.terminal, ev_down.direction = True, -1.0
+            events += [ev_up, ev_down]
+            actions += [(s, "phase", +1), (s, "phase", -1)]
+            if m.lu > 0.0:
+                e_i, Ea, Eb = mcs[s][4], mcs[s][5], mcs[s][6]
+                lu = m.lu
+                if c == 1:
+                    defs = [(-(lu - _ETA_D), -1.0, 0)]
+                elif c == -1:
+                    defs = [(lu - _ETA_D, 1.0, 0)]
+                else:
+                    defs = [(-(lu + _ETA_D), 1.0, 1), (lu + _ETA_D, -1.0, -1)]
+                for offset, direction, new_c in defs:
+
+                    def ev(t, y, offset=offset, c_=(ip, iw, cz, r1, r2, e_i, Ea, Eb, float(n))):
+                        ip, iw, cz, r1, r2, e_i, Ea, Eb, nf = c_
+                        return r1 * y[ip] - r2 * y[iw] + e_i * (Ea + Eb * (y[ip] * cz - nf)) + offset
+
+                    ev.terminal, ev.direction = True, direction
+                    events.append(ev)
+                    actions.append((s, "contact", new_c))
+        return events, actions
+
+    def default_atol(self, rtol: float) -> np.ndarray:
+        """Same rule as one-stage, with the smallest angle scale and the fastest mesh of all stages."""
+        ang = min(rtol * m.defl_scale / max(m.r1, m.r2) for m in self.meshes)
+        om = max(m.omega_n for m in self.meshes)
+        return np.concatenate((np.full(self.n_dof, ang), np.full(self.n_dof, ang * om)))
+
+
+def _simulate_train(scenario: dict, t_eval, rtol: float, atol, method: str) -> dict[str, np.ndarray]:
+    """Segmented integration of a train: a segment ends at the first jump of ANY mesh."""
+    model = _Train(scenario)
+    t_eval = _output_times(scenario, t_eval)
+    t_stop = float(t_eval[-1])
+    if atol is None:
+        atol = model.default_atol(rtol)
+    nd, N = model.n_dof, model.N
+    q0, v0 = initial_state(scenario)
+    y = np.concatenate((q0, v0))
+    n_t = t_eval.size
+    Y = np.full((2 * nd, n_t), np.nan)
+    F_out = np.full((N, n_t), np.nan)
+    tbreaks = _time_breaks(model, t_stop)
+    modes = model.initial_modes(y)
+
+    t = 0.0
+    nfev = n_segments = n_missed = zero_segments = 0
+    i_out = 0
+    h_prev = None
+
+    def fill_outputs(sol, t_hi, mcs, include_end):
+        nonlocal i_out
+        j = i_out
+        while j < n_t and (t_eval[j] < t_hi or (include_end and t_eval[j] <= t_hi)):
+            j += 1
+        if j > i_out:
+            ts = t_eval[i_out:j]
+            ys = sol(ts) if sol is not None else np.repeat(y[:, None], ts.size, axis=1)
+            Y[:, i_out:j] = ys
+            for s in range(N):
+                u, delta, ddot = model.kin(s, ys)
+                F_out[s, i_out:j] = _mesh_force(mcs[s], u - modes[s][0], delta, ddot)
+            i_out = j
+
+    if t_stop == 0.0:
+        _, mcs = model.make_rhs(modes, _chunk(model, 0.0, 1.0, 0.0))
+        fill_outputs(None, 0.0, mcs, True)
+
+    for ib, tb in enumerate(tbreaks):
+        if t >= tb:  # t_stop == 0
+            break
+        chunk = _chunk(model, t, tb, 0.0)
+        last_chunk = ib == len(tbreaks) - 1
+        while t < tb:
+            rhs, mcs = model.make_rhs(modes, chunk)
+            events, actions = model.make_events(modes, mcs)
+            first = min(h_prev, tb - t) if h_prev else None
+            res = solve_ivp(
+                rhs, (t, tb), y, method=method, rtol=rtol, atol=atol, events=events,
+                dense_output=True, first_step=first,
+            )  # fmt: skip
+            if res.status < 0:
+                raise RuntimeError(f"solve_ivp failed at t={t}: {res.message}")
+            nfev += int(res.nfev)
+            n_segments += 1
+            t_new = float(res.t[-1])
+            y_new = res.y[:, -1].copy()
+            fired = []
+            if res.status == 1:
+                fired = [m for m, te in enumerate(res.t_events) if te.size and te[0] == t_new]
+            missed = _scan_missed_events(res.sol, events, t, t_new)
+            if missed is not None:
+                fired = [missed[0]]
+                t_new = float(missed[1])
+                y_new = res.sol(t_new)
+                n_missed += 1
+            h_prev = _step_hint(res, h_prev)
+            fill_outputs(res.sol, t_new, mcs, last_chunk and not fired)
+            if fired:
+                zero_segments = zero_segments + 1 if t_new == t else 0
+                if zero_segments > _MAX_ZERO_SEGMENTS:
+                    raise RuntimeError(f"mode chattering at t={t_new} (modes {modes})")
+                phase_changed, contact_set = set(), set()
+                for m in fired:
+                    s, kind, val = actions[m]
+                    if kind == "phase":
+                        modes[s][0], modes[s][1] = model.meshes[s].step_phase(modes[s][0], modes[s][1], val)
+                        phase_changed.add(s)
+                    else:
+                        modes[s][2] = val
+                        contact_set.add(s)
+                for s in phase_changed - contact_set:
+                    mesh = model.meshes[s]
+                    if mesh.lu > 0.0:
+                        # the error E can jump at a tooth change (a = 0 or 1): re-classify the contact
+                        d_new, dd_new = model.deflection(s, modes[s][0], modes[s][1], y_new)
+                        if abs(abs(d_new) - mesh.lu) > 10 * _ETA_D:
+                            modes[s][2] = mesh.contact_mode(float(d_new), float(dd_new))
+            t, y = t_new, y_new
+    if i_out < n_t:
+        raise RuntimeError("internal error: not all output times were filled")
+    stage_kd = F_out / model.Frated[:, None]
+    return {
+        "time": t_eval,
+        "coordinates": Y[:nd],
+        "velocities": Y[nd:],
+        "mesh_force_N": F_out[0].copy(),
+        "kd": stage_kd[0].copy(),
+        "stage_mesh_force_N": F_out,
+        "stage_kd": stage_kd,
+        "nfev": np.array(nfev),
+        "n_segments": np.array(n_segments),
+        "n_missed_events": np.array(n_missed),
+    }
+
+
+def _output_times(scenario: dict, t_eval) -> np.ndarray:
+    """t_eval, or the spec's grid t = k / output_rate_hz, k = 0 .. floor(t_end * rate)."""
+    if t_eval is None:
+        rate = float(scenario["solver"]["output_rate_hz"])
+        n_out = math.floor(float(scenario["operation"]["t_end_s"]) * rate)
+        t_eval = np.arange(n_out + 1) / rate
+    t_eval = np.asarray(t_eval, dtype=float).ravel()
+    if t_eval.size == 0 or t_eval[0] < 0.0 or np.any(np.diff(t_eval) < 0.0):
+        raise ValueError("t_eval must be non-empty, non-negative and non-decreasing")
+    return t_eval
+
+
+def _time_breaks(model, t_stop: float) -> list[float]:
+    """Segment ends in time: the break points of the speed and load profiles, and t_stop."""
+    tbreaks = {t_stop}
+    for prof in (model.speed_prof, model.load_prof):
+        tbreaks.update(float(x) for x in prof["time_s"] if 0.0 < float(x) < t_stop)
+    return sorted(tbreaks)
+
+
+def _step_hint(res, h_prev):
+    """First step for the next segment: the last full step size solve_ivp took."""
+    ts_steps = res.sol.ts
+    if ts_steps.size >= 3:
+        return float(ts_steps[-2] - ts_steps[-3])
+    if ts_steps.size == 2 and res.status == 0:
+        return float(ts_steps[-1] - ts_steps[-2])
+    return h_prev
+
+
 def simulate_reference(
     scenario: dict,
     t_eval: np.ndarray | None = None,
@@ -643,18 +1115,17 @@ def simulate_reference(
     """Integrate a resolved scenario; see the module docstring.
 
     Returns time, coordinates and velocities (n_dof x n_t), mesh_force_N (F = F_el + F_t),
-    kd = F / F_rated and nfev (0-d array); for diagnostics also n_segments (restarts of
-    solve_ivp) and n_missed_events (mode boundaries found inside a step by the dense scan).
+    kd = F / F_rated, stage_mesh_force_N and stage_kd (n_stages x n_t; one row for the one-mesh
+    scenes) and nfev (0-d array); for diagnostics also n_segments (restarts of solve_ivp) and
+    n_missed_events (mode boundaries found inside a step by the dense scan).
+
+    Train (N stages): coordinates [motor, pinion_1, wheel_1, ..., pinion_N, wheel_N, machine]
+    (n_dof = 2N + 2); mesh_force_N / kd are those of the first stage, stage_kd[s] = F_s / F_rated,s.
     """
+    if is_train(scenario):
+        return _simulate_train(scenario, t_eval, rtol, atol, method)
     model = _Model(scenario)
-    op = scenario["operation"]
-    if t_eval is None:
-        rate = float(scenario["solver"]["output_rate_hz"])
-        n_out = math.floor(float(op["t_end_s"]) * rate)
-        t_eval = np.arange(n_out + 1) / rate
-    t_eval = np.asarray(t_eval, dtype=float).ravel()
-    if t_eval.size == 0 or t_eval[0] < 0.0 or np.any(np.diff(t_eval) < 0.0):
-        raise ValueError("t_eval must be non-empty, non-negative and non-decreasing")
+    t_eval = _output_times(scenario, t_eval)
     t_stop = float(t_eval[-1])
     if atol is None:
         atol = model.default_atol(rtol)
@@ -665,11 +1136,7 @@ def simulate_reference(
     Y = np.full((2 * nd, n_t), np.nan)
     F_out = np.full(n_t, np.nan)
 
-    # time break points of the profiles
-    tbreaks = {t_stop}
-    for prof in (model.speed_prof, model.load_prof):
-        tbreaks.update(float(x) for x in prof["time_s"] if 0.0 < float(x) < t_stop)
-    tbreaks = sorted(tbreaks)
+    tbreaks = _time_breaks(model, t_stop)
 
     # initial modes
     t = 0.0
@@ -752,11 +1219,7 @@ def simulate_reference(
                 t_new = float(missed[1])
                 y_new = res.sol(t_new)
                 n_missed += 1
-            ts_steps = res.sol.ts
-            if ts_steps.size >= 3:
-                h_prev = float(ts_steps[-2] - ts_steps[-3])
-            elif ts_steps.size == 2 and res.status == 0:
-                h_prev = float(ts_steps[-1] - ts_steps[-2])
+            h_prev = _step_hint(res, h_prev)
             fill_outputs(res.sol, t, t_new, mc, last_chunk and not fired)
             if fired:
                 zero_segments = zero_segments + 1 if t_new == t else 0
@@ -766,11 +1229,7 @@ def simulate_reference(
                 for m in fired:
                     kind, val = actions[m]
                     if kind == "phase":
-                        k += val
-                        if k >= model.K:
-                            k, n = 0, n + 1
-                        elif k < 0:
-                            k, n = model.K - 1, n - 1
+                        n, k = model.step_phase(n, k, val)
                         phase_changed = True
                     else:
                         c = val
@@ -788,6 +1247,8 @@ def simulate_reference(
         "velocities": Y[nd:],
         "mesh_force_N": F_out,
         "kd": F_out / model.Frated,
+        "stage_mesh_force_N": F_out[None, :].copy(),
+        "stage_kd": (F_out / model.Frated)[None, :],
         "nfev": np.array(nfev),
         "n_segments": np.array(n_segments),
         "n_missed_events": np.array(n_missed),
