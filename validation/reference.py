@@ -349,8 +349,11 @@ def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     M_p = F0 * r1
     f, g = tooth_factors(scenario)
     k0 = float(base_stiffness(0.0, mesh)) * f[0] * g[0]
-    E0 = float(error_shape(0.0, float(scenario["production"]["error_mode"]["a"]),
-                           tooth_error_amplitudes(scenario)[0]))  # non-zero only for a = 0
+    E0 = float(
+        error_shape(
+            0.0, float(scenario["production"]["error_mode"]["a"]), tooth_error_amplitudes(scenario)[0]
+        )
+    )  # non-zero only for a = 0
     delta0 = F0 / k0 + lu - E0 if F0 != 0.0 else 0.0
     if scene == "muller":
         q0[0] = delta0
