@@ -1,11 +1,12 @@
-"""Wall seconds per simulated second of the one-stage scene at rated load (not a test).
+"""Wall seconds per simulated second of a scene at rated load (not a test; default scene one-stage).
 
-Runs gearbody on one-stage, steady rated running with E(0.5, 10, 0.3) and friction mu = 0.05,
+Runs gearbody on the scene, steady rated running with E(0.5, 10, 0.3) (train scenes: their own
+per-stage error modes, E(0.5, 10, 0.3) in the shipped ones) and friction mu = 0.05,
 1 s simulated, after a warm-up run (numba compilation is cached and not counted); optionally also
 the independent scipy reference for the ratio. Prints a table and appends it to benchmarks/RESULTS.md
 with --write.
 
-    python benchmarks/bench_one_stage.py [--t-end 1.0] [--repeat 3] [--reference] [--write]
+    python benchmarks/bench_scene.py [--scene NAME] [--t-end 1.0] [--repeat 3] [--reference] [--write]
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ RATED = [
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scene", default="one-stage")
     ap.add_argument("--t-end", type=float, default=1.0)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--reference", action="store_true", help="also time the scipy reference")
@@ -43,9 +45,9 @@ def main() -> None:
         help="also run tolerances 1e-9..1e-12 and give each one's max |dF|/F_rated vs the reference",
     )
     args = ap.parse_args()
-    sc = load_scenario("one-stage", [*RATED, f"operation.t_end_s={args.t_end}"])
+    sc = load_scenario(args.scene, [*RATED, f"operation.t_end_s={args.t_end}"])
     t0 = time.perf_counter()
-    simulate(load_scenario("one-stage", [*RATED, "operation.t_end_s=0.01"]))  # warm-up (numba cache)
+    simulate(load_scenario(args.scene, [*RATED, "operation.t_end_s=0.01"]))  # warm-up (numba cache)
     first_build = time.perf_counter() - t0
     walls, res = [], None
     for _ in range(args.repeat):
@@ -55,7 +57,7 @@ def main() -> None:
     stats = res.meta["solver_statistics"]
     wall = min(walls)
     lines = [
-        f"## one-stage, rated, E(0.5,10,0.3), mu 0.05, {args.t_end} s simulated ({date.today()}, "
+        f"## {args.scene}, rated, E(0.5,10,0.3), mu 0.05, {args.t_end} s simulated ({date.today()}, "
         f"{platform.processor() or platform.machine()}, gearbody {gearbody.__version__})",
         "",
         "| run | wall s per simulated s | steps | rejected | notes |",
@@ -86,7 +88,7 @@ def main() -> None:
         ]
         for tol in (1e-9, 1e-10, 1e-11, 1e-12):
             sct = load_scenario(
-                "one-stage",
+                args.scene,
                 [
                     *RATED,
                     f"operation.t_end_s={args.t_end}",
