@@ -712,14 +712,7 @@ class _Model(_Mesh):
                 u, delta, _ = kin(t, y, theta)
                 return delta + e_i * (Ea + Eb * (u - nf))
 
-            lu = self.lu
-            if c == 1:
-                defs = [(-(lu - _ETA_D), -1.0, 0)]
-            elif c == -1:
-                defs = [(lu - _ETA_D, 1.0, 0)]
-            else:
-                defs = [(-(lu + _ETA_D), 1.0, 1), (lu + _ETA_D, -1.0, -1)]
-            for offset, direction, new_c in defs:
+            for offset, direction, new_c in _contact_edges(self.lu, c):
 
                 def ev(t, y, offset=offset):
                     return dfun(t, y) + offset
@@ -945,14 +938,7 @@ class _Train:
             actions += [(s, "phase", +1), (s, "phase", -1)]
             if m.lu > 0.0:
                 e_i, Ea, Eb = mcs[s][4], mcs[s][5], mcs[s][6]
-                lu = m.lu
-                if c == 1:
-                    defs = [(-(lu - _ETA_D), -1.0, 0)]
-                elif c == -1:
-                    defs = [(lu - _ETA_D, 1.0, 0)]
-                else:
-                    defs = [(-(lu + _ETA_D), 1.0, 1), (lu + _ETA_D, -1.0, -1)]
-                for offset, direction, new_c in defs:
+                for offset, direction, new_c in _contact_edges(m.lu, c):
 
                     def ev(t, y, offset=offset, c_=(ip, iw, cz, r1, r2, e_i, Ea, Eb, float(n))):
                         ip, iw, cz, r1, r2, e_i, Ea, Eb, nf = c_
@@ -1018,25 +1004,10 @@ def _simulate_train(scenario: dict, t_eval, rtol: float, atol, method: str) -> d
             rhs, mcs = model.make_rhs(modes, chunk)
             events, actions = model.make_events(modes, mcs)
             first = min(h_prev, tb - t) if h_prev else None
-            res = solve_ivp(
-                rhs, (t, tb), y, method=method, rtol=rtol, atol=atol, events=events,
-                dense_output=True, first_step=first,
-            )  # fmt: skip
-            if res.status < 0:
-                raise RuntimeError(f"solve_ivp failed at t={t}: {res.message}")
+            res, t_new, y_new, fired, was_missed = _segment(rhs, t, tb, y, events, method, rtol, atol, first)
             nfev += int(res.nfev)
             n_segments += 1
-            t_new = float(res.t[-1])
-            y_new = res.y[:, -1].copy()
-            fired = []
-            if res.status == 1:
-                fired = [m for m, te in enumerate(res.t_events) if te.size and te[0] == t_new]
-            missed = _scan_missed_events(res.sol, events, t, t_new)
-            if missed is not None:
-                fired = [missed[0]]
-                t_new = float(missed[1])
-                y_new = res.sol(t_new)
-                n_missed += 1
+            n_missed += was_missed
             h_prev = _step_hint(res, h_prev)
             fill_outputs(res.sol, t_new, mcs, last_chunk and not fired)
             if fired:
@@ -1095,6 +1066,47 @@ def _time_breaks(model, t_stop: float) -> list[float]:
     for prof in (model.speed_prof, model.load_prof):
         tbreaks.update(float(x) for x in prof["time_s"] if 0.0 < float(x) < t_stop)
     return sorted(tbreaks)
+
+
+def _contact_edges(lu: float, c: int) -> list[tuple[float, float, int]]:
+    """Dead-zone edges to watch from contact state c (1 drive flank, -1 back flank, 0 in the gap):
+    (offset of d, crossing direction, contact state after the crossing), with hysteresis _ETA_D."""
+    if c == 1:
+        return [(-(lu - _ETA_D), -1.0, 0)]
+    if c == -1:
+        return [(lu - _ETA_D, 1.0, 0)]
+    return [(-(lu + _ETA_D), 1.0, 1), (lu + _ETA_D, -1.0, -1)]
+
+
+def _segment(rhs, t: float, tb: float, y, events, method: str, rtol: float, atol, first):
+    """Integrate one smooth segment from t towards tb, stopping at the first jump.
+
+    Returns (result, t_end, y_end, indices of the events that fired there, 1 if the jump was found
+    by the sub-step scan rather than by solve_ivp).
+    """
+    res = solve_ivp(
+        rhs,
+        (t, tb),
+        y,
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        events=events,
+        dense_output=True,
+        first_step=first,
+    )
+    if res.status < 0:
+        raise RuntimeError(f"solve_ivp failed at t={t}: {res.message}")
+    t_new = float(res.t[-1])
+    y_new = res.y[:, -1].copy()
+    fired = []
+    if res.status == 1:
+        fired = [m for m, te in enumerate(res.t_events) if te.size and te[0] == t_new]
+    missed = _scan_missed_events(res.sol, events, t, t_new)
+    if missed is None:
+        return res, t_new, y_new, fired, 0
+    t_new = float(missed[1])
+    return res, t_new, res.sol(t_new), [missed[0]], 1
 
 
 def _step_hint(res, h_prev):
@@ -1196,32 +1208,10 @@ def simulate_reference(
             rhs, mc = model.make_rhs(n, k, c, chunk)
             events, actions = model.make_events(n, k, c, mc, theta)
             first = min(h_prev, tb - t) if h_prev else None
-            res = solve_ivp(
-                rhs,
-                (t, tb),
-                y,
-                method=method,
-                rtol=rtol,
-                atol=atol,
-                events=events,
-                dense_output=True,
-                first_step=first,
-            )
-            if res.status < 0:
-                raise RuntimeError(f"solve_ivp failed at t={t}: {res.message}")
+            res, t_new, y_new, fired, was_missed = _segment(rhs, t, tb, y, events, method, rtol, atol, first)
             nfev += int(res.nfev)
             n_segments += 1
-            t_new = float(res.t[-1])
-            y_new = res.y[:, -1].copy()
-            fired = []
-            if res.status == 1:
-                fired = [m for m, te in enumerate(res.t_events) if te.size and te[0] == t_new]
-            missed = _scan_missed_events(res.sol, events, t, t_new)
-            if missed is not None:
-                fired = [missed[0]]
-                t_new = float(missed[1])
-                y_new = res.sol(t_new)
-                n_missed += 1
+            n_missed += was_missed
             h_prev = _step_hint(res, h_prev)
             fill_outputs(res.sol, t, t_new, mc, last_chunk and not fired)
             if fired:
