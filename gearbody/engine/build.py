@@ -2,6 +2,13 @@
 connectors, and each gear mesh is a user-function connector (``ObjectGenericODE2`` on the two gear
 nodes) calling the compiled mesh law of :mod:`gearbody.physics.mesh`.
 
+A gear on lateral bearings is a planar rigid body (``NodeRigidBody2D`` + ``ObjectRigidBody2D``,
+coordinates x, y, rotation; its rotation coordinate is the angle in its own driven direction, so no
+sign changes are needed between torsional and lateral gears). A direction held fixed ("y" gears) is a
+``CoordinateConstraint`` to ground, which Exudyn's explicit solvers eliminate. Linear bearings are
+``ObjectConnectorCoordinateSpringDamper`` per free direction; any other bearing law is an
+``ObjectGenericODE2`` on the gear node calling the law's ``force_N``.
+
 The motor and the load are ``ObjectGenericODE2`` items on one node each, so their torques can depend
 on speed and time. For modes, the mesh becomes a constant stiffness matrix at mean mesh stiffness
 and the motor and load are left out (free ends).
@@ -14,11 +21,15 @@ from dataclasses import dataclass, field
 import exudyn as exu
 import numpy as np
 from exudyn.itemInterface import (
+    CoordinateConstraint,
     MarkerNodeCoordinate,
     Node1D,
+    NodePointGround,
+    NodeRigidBody2D,
     ObjectConnectorCoordinateSpringDamper,
     ObjectGenericODE2,
     ObjectMass1D,
+    ObjectRigidBody2D,
     ObjectRotationalMass1D,
     SensorNode,
     VObjectGenericODE2,
@@ -26,9 +37,11 @@ from exudyn.itemInterface import (
 
 from ..model import Scenario
 from ..physics import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
+from ..physics.bearings import LinearBearing
+from ..physics.lateral import lateral_mesh_forces, tangent_stiffness_N_per_m
 from ..physics.mesh import mesh_contact, mesh_parameters_from_scenario, torsional_mesh_forces
 from ..physics.motor import pack_drive_parameters
-from .layout import TorsionalLayout, reduced_mass_kg
+from .layout import Inertia, TorsionalLayout, reduced_mass_kg
 
 OVT = exu.OutputVariableType
 HIDDEN = VObjectGenericODE2(show=False)
@@ -40,10 +53,11 @@ class BuiltSystem:
 
     system_container: exu.SystemContainer
     mbs: exu.MainSystem
-    dof_names: list[str]
+    dof_names: list[str]  # one per ODE2 coordinate, in Exudyn's order ("pinion_x", "pinion_y", "pinion")
     nodes: list[int]
     sensors: dict[str, list[int]] = field(default_factory=dict)  # kind -> one sensor per node
     user_functions: list = field(default_factory=list)  # keep references alive
+    fixed_coordinates: list[int] = field(default_factory=list)  # held at 0 (CoordinateConstraint)
 
 
 def _add_nodes(mbs, masses: list[tuple[str, float]], q0, v0, *, rotational: bool) -> list[int]:
@@ -75,51 +89,101 @@ def _add_sensors(built: BuiltSystem) -> None:
         ]
 
 
-def build_torsional(
-    layout: TorsionalLayout, q0=None, v0=None, *, modal_mesh_stiffness_N_per_m=None, sensors: bool = True
-) -> BuiltSystem:
-    """Exudyn system of a torsional layout.
+def _node_coordinate_names(b: Inertia) -> list[str]:
+    return [f"{b.name}_x", f"{b.name}_y", b.name] if b.lateral is not None else [b.name]
 
-    With ``modal_mesh_stiffness_N_per_m`` (one value for all meshes, or one per mesh) the meshes are
-    constant line-of-action springs of that
-    stiffness (no backlash, errors or friction), and the motor and load are left out: the linearised
-    system for natural frequencies.
+
+def build_torsional(
+    layout: TorsionalLayout,
+    q0=None,
+    v0=None,
+    *,
+    lateral_u0: dict[str, np.ndarray] | None = None,
+    modal_mesh_stiffness_N_per_m=None,
+    sensors: bool = True,
+) -> BuiltSystem:
+    """Exudyn system of a layout (torsional, or with gears on lateral bearings).
+
+    ``q0``/``v0`` are the rotations and speeds (one per inertia); ``lateral_u0`` the initial centre
+    displacements of lateral gears (lateral velocities start at 0). With
+    ``modal_mesh_stiffness_N_per_m`` (one value for all meshes, or one per mesh) the meshes are
+    constant line-of-action springs of that stiffness (no backlash, errors or friction), nonlinear
+    bearings are replaced by their tangent stiffness at ``lateral_u0``, directions held fixed are
+    listed in ``fixed_coordinates`` instead of constrained, and the motor and load are left out: the
+    linearised system for natural frequencies.
     """
     n = len(layout.inertias)
     q0 = np.zeros(n) if q0 is None else q0
     v0 = np.zeros(n) if v0 is None else v0
+    lateral_u0 = lateral_u0 or {}
+    modal = modal_mesh_stiffness_N_per_m is not None
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
-    nodes = _add_nodes(mbs, [(b.name, b.inertia_kg_m2) for b in layout.inertias], q0, v0, rotational=True)
-    built = BuiltSystem(SC, mbs, layout.names, nodes)
-    markers = [mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=nd, coordinate=0)) for nd in nodes]
-    for s in layout.shafts:
+    nodes, names = [], []
+    for k, b in enumerate(layout.inertias):
+        if b.lateral is None:
+            nd = mbs.AddNode(
+                Node1D(referenceCoordinates=[0.0], initialCoordinates=[float(q0[k])], initialVelocities=[float(v0[k])])
+            )
+            mbs.AddObject(ObjectRotationalMass1D(nodeNumber=nd, inertia=b.inertia_kg_m2))
+        else:
+            u0 = lateral_u0.get(b.name, np.zeros(2))
+            nd = mbs.AddNode(
+                NodeRigidBody2D(
+                    referenceCoordinates=[0.0, 0.0, 0.0],
+                    initialCoordinates=[float(u0[0]), float(u0[1]), float(q0[k])],
+                    initialVelocities=[0.0, 0.0, float(v0[k])],
+                )
+            )
+            mbs.AddObject(ObjectRigidBody2D(nodeNumber=nd, mass=b.lateral.mass_kg, inertia=b.inertia_kg_m2))
+        nodes.append(nd)
+        names += _node_coordinate_names(b)
+    built = BuiltSystem(SC, mbs, names, nodes)
+    rot = [
+        mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=nd, coordinate=0 if b.lateral is None else 2))
+        for nd, b in zip(nodes, layout.inertias, strict=True)
+    ]
+    for sh in layout.shafts:
         mbs.AddObject(
             ObjectConnectorCoordinateSpringDamper(
-                markerNumbers=[markers[s.i], markers[s.j]],
-                stiffness=s.stiffness_Nm_per_rad,
-                damping=s.damping_Nms_per_rad,
+                markerNumbers=[rot[sh.i], rot[sh.j]],
+                stiffness=sh.stiffness_Nm_per_rad,
+                damping=sh.damping_Nms_per_rad,
             )
         )
-    modal = modal_mesh_stiffness_N_per_m is not None
+    if layout.is_lateral:
+        _add_bearings(built, layout, lateral_u0, modal)
     if modal:
         k_modal = np.broadcast_to(np.asarray(modal_mesh_stiffness_N_per_m, float), (len(layout.meshes),))
     for index, m in enumerate(layout.meshes):
         pair = [nodes[m.pinion], nodes[m.wheel]]
+        bp, bw = layout.inertias[m.pinion], layout.inertias[m.wheel]
+        size = len(_node_coordinate_names(bp)) + len(_node_coordinate_names(bw))
+        idx = _mesh_coordinate_index(bp, bw)
         if modal:
-            r1, r2 = m.r_pinion_m, m.r_wheel_m
-            K = k_modal[index] * np.array([[r1 * r1, -r1 * r2], [-r1 * r2, r2 * r2]])
+            g = np.zeros(size)
+            g[idx[0]], g[idx[3]] = m.r_pinion_m, -m.r_wheel_m
+            if idx[1] >= 0:
+                g[idx[1]], g[idx[2]] = m.line_of_action
+            if idx[4] >= 0:
+                g[idx[4]], g[idx[5]] = -m.line_of_action[0], -m.line_of_action[1]
             mbs.AddObject(
                 ObjectGenericODE2(
-                    nodeNumbers=pair, massMatrix=np.zeros((2, 2)), stiffnessMatrix=K, visualization=HIDDEN
+                    nodeNumbers=pair,
+                    massMatrix=np.zeros((size, size)),
+                    stiffnessMatrix=k_modal[index] * np.outer(g, g),
+                    visualization=HIDDEN,
                 )
             )
             continue
-        built.user_functions.append(_mesh_user_function(m.parameters))
+        if size == 2:
+            built.user_functions.append(_mesh_user_function(m.parameters))
+        else:
+            built.user_functions.append(_lateral_mesh_user_function(m, bp, bw, idx))
         mbs.AddObject(
             ObjectGenericODE2(
                 nodeNumbers=pair,
-                massMatrix=np.zeros((2, 2)),
+                massMatrix=np.zeros((size, size)),
                 forceUserFunction=built.user_functions[-1],
                 visualization=HIDDEN,
             )
@@ -150,6 +214,68 @@ def build_torsional(
         _add_sensors(built)
     mbs.Assemble()
     return built
+
+
+def _mesh_coordinate_index(bp: Inertia, bw: Inertia) -> np.ndarray:
+    """Positions in the mesh connector's q of [pinion rot, x, y, wheel rot, x, y] (-1: none)."""
+    idx = []
+    offset = 0
+    for b in (bp, bw):
+        if b.lateral is None:
+            idx += [offset, -1, -1]
+            offset += 1
+        else:
+            idx += [offset + 2, offset, offset + 1]
+            offset += 3
+    return np.array(idx, dtype=np.int64)
+
+
+def _add_bearings(built: BuiltSystem, layout: TorsionalLayout, lateral_u0, modal: bool) -> None:
+    mbs = built.mbs
+    ground = mbs.AddNode(NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
+    ground_markers = [mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=d)) for d in (0, 1)]
+    offset = 0
+    for nd, b in zip(built.nodes, layout.inertias, strict=True):
+        size = 1 if b.lateral is None else 3
+        if b.lateral is None:
+            offset += size
+            continue
+        sup, law = b.lateral, b.lateral.bearing
+        markers = [mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=nd, coordinate=d)) for d in (0, 1)]
+        for d in (0, 1):
+            if d not in sup.free_directions:
+                if modal:
+                    built.fixed_coordinates.append(offset + d)
+                else:
+                    mbs.AddObject(CoordinateConstraint(markerNumbers=[ground_markers[d], markers[d]]))
+        if isinstance(law, LinearBearing):
+            k = (law.stiffness_x_N_per_m, law.stiffness_y_N_per_m)
+            c = (law.damping_x_Ns_per_m, law.damping_y_Ns_per_m)
+            for d in sup.free_directions:
+                mbs.AddObject(
+                    ObjectConnectorCoordinateSpringDamper(
+                        markerNumbers=[ground_markers[d], markers[d]], stiffness=k[d], damping=c[d]
+                    )
+                )
+        elif modal:
+            K = np.zeros((3, 3))
+            K[:2, :2] = tangent_stiffness_N_per_m(law, lateral_u0.get(b.name, np.zeros(2)))
+            mbs.AddObject(
+                ObjectGenericODE2(
+                    nodeNumbers=[nd], massMatrix=np.zeros((3, 3)), stiffnessMatrix=K, visualization=HIDDEN
+                )
+            )
+        else:
+            built.user_functions.append(_bearing_user_function(law, sup.free_directions))
+            mbs.AddObject(
+                ObjectGenericODE2(
+                    nodeNumbers=[nd],
+                    massMatrix=np.zeros((3, 3)),
+                    forceUserFunction=built.user_functions[-1],
+                    visualization=HIDDEN,
+                )
+            )
+        offset += size
 
 
 def build_muller(scenario: Scenario, q0, v0, *, sensors: bool = True) -> BuiltSystem:
@@ -186,6 +312,27 @@ def _mesh_user_function(P: np.ndarray):
         return torsional_mesh_forces(q[0], q[1], q_t[0], q_t[1], P)
 
     return mesh_force
+
+
+def _lateral_mesh_user_function(m, bp: Inertia, bw: Inertia, idx: np.ndarray):
+    free = [float(d in b.lateral.free_directions) if b.lateral else 0.0 for b in (bp, bw) for d in (0, 1)]
+    geometry = np.array([*m.line_of_action, *m.friction_direction, *free])
+    P = m.parameters
+
+    def lateral_mesh_force(mbs, t, itemNumber, q, q_t):
+        return lateral_mesh_forces(np.asarray(q), np.asarray(q_t), idx, geometry, P)
+
+    return lateral_mesh_force
+
+
+def _bearing_user_function(law, free_directions: tuple[int, ...]):
+    mask = np.array([float(d in free_directions) for d in (0, 1)])
+
+    def bearing_force(mbs, t, itemNumber, q, q_t):
+        f = np.asarray(law.force_N(np.asarray(q[:2]) * mask, np.asarray(q_t[:2]) * mask), float) * mask
+        return [f[0], f[1], 0.0]
+
+    return bearing_force
 
 
 def _motor_user_function(D: np.ndarray):

@@ -1,4 +1,5 @@
-"""Topology of a torsional system, as read from a scenario: inertias, shafts, meshes, drive and load.
+"""Topology of a drive, as read from a scenario: inertias (gears optionally on lateral bearings), shafts,
+meshes, drive and load.
 
 This is the one place where a scene becomes bodies and connectors; the Exudyn builder then creates
 exactly what it lists. It imports no Exudyn, so it also serves the linearised modal model.
@@ -13,13 +14,26 @@ import numpy as np
 
 from ..model import Scenario
 from ..physics import mesh_parameters_from_scenario, pack_drive_parameters, steady_slip
+from ..physics.lateral import mesh_directions, static_bearing_displacement_m
 from ..physics.mesh import mesh_phase_series, stiffness_at_phase, tooth_error_m, tooth_pair_factor
+
+
+@dataclass(frozen=True)
+class LateralSupport:
+    """A gear centre that translates on a bearing: free directions (0 = x, 1 = y), mass, bearing law."""
+
+    free_directions: tuple[int, ...]
+    mass_kg: float
+    bearing: object = field(repr=False)  # a gearbody.physics.bearings law (force_N method)
+    bearing_kind: str = "linear"
+    housing_mass_kg: float = 50.0
 
 
 @dataclass(frozen=True)
 class Inertia:
     name: str
     inertia_kg_m2: float
+    lateral: LateralSupport | None = None
 
 
 @dataclass(frozen=True)
@@ -41,6 +55,8 @@ class MeshLink:
     r_pinion_m: float
     r_wheel_m: float
     parameters: np.ndarray = field(repr=False)
+    line_of_action: tuple[float, float] = (0.0, -1.0)  # n: direction of the force on the wheel
+    friction_direction: tuple[float, float] = (-1.0, 0.0)  # m: friction force on the pinion is +T m
 
 
 @dataclass(frozen=True)
@@ -55,6 +71,10 @@ class TorsionalLayout:
     @property
     def names(self) -> list[str]:
         return [b.name for b in self.inertias]
+
+    @property
+    def is_lateral(self) -> bool:
+        return any(b.lateral is not None for b in self.inertias)
 
 
 def gear_names(stage: int) -> tuple[str, str]:
@@ -89,9 +109,21 @@ def torsional_layout(scenario: Scenario) -> TorsionalLayout:
     meshes = []
     for k, st in enumerate(stages):
         pname, wname = gear_names(k)
-        inertias += [Inertia(pname, st.pinion.inertia_kg_m2), Inertia(wname, st.wheel.inertia_kg_m2)]
+        inertias += [
+            Inertia(pname, st.pinion.inertia_kg_m2, _support(st.pinion)),
+            Inertia(wname, st.wheel.inertia_kg_m2, _support(st.wheel)),
+        ]
+        n, m, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
         meshes.append(
-            MeshLink(2 * k + 1, 2 * k + 2, st.pinion.base_radius_m, st.wheel.base_radius_m, params[k])
+            MeshLink(
+                2 * k + 1,
+                2 * k + 2,
+                st.pinion.base_radius_m,
+                st.wheel.base_radius_m,
+                params[k],
+                (float(n[0]), float(n[1])),
+                (float(m[0]), float(m[1])),
+            )
         )
     inertias.append(Inertia("machine", d.machine.inertia_kg_m2))
     shafts = tuple(
@@ -101,6 +133,35 @@ def torsional_layout(scenario: Scenario) -> TorsionalLayout:
     return TorsionalLayout(
         tuple(inertias), shafts, tuple(meshes), motor_at=0, load_at=len(inertias) - 1, drive=drive
     )
+
+
+def _support(gear) -> LateralSupport | None:
+    if gear.lateral == "none":
+        return None
+    return LateralSupport(
+        gear.free_directions, gear.mass_kg, gear.bearing.law(), gear.bearing.kind, gear.bearing.housing_mass_kg
+    )
+
+
+def static_lateral_displacements_m(scenario: Scenario) -> dict[str, np.ndarray]:
+    """Initial centre displacement (x, y) of every lateral gear: 0 from rest; at the static bearing
+    deflection under the steady mesh force (friction ignored) for 'steady'."""
+    out: dict[str, np.ndarray] = {}
+    forces = None
+    if scenario.operation.initial_state == "steady":
+        forces = steady_operating_point(scenario)["mesh_force_N"]
+    for k, st in enumerate(scenario.stages):
+        n, _, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
+        for name, gear, sign in zip(gear_names(k), (st.pinion, st.wheel), (-1.0, 1.0), strict=True):
+            if gear.lateral == "none":
+                continue
+            if forces is None:
+                out[name] = np.zeros(2)
+            else:
+                out[name] = static_bearing_displacement_m(
+                    gear.bearing.law(), sign * forces[k] * n, gear.free_directions
+                )
+    return out
 
 
 def reduced_mass_kg(scenario: Scenario) -> float:
@@ -176,11 +237,15 @@ def initial_state(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
             np.array([op["pinion_speed_rad_s"][0], op["wheel_speed_rad_s"][0]]),
         )
     shafts = chain_shafts(scenario)
+    lateral = static_lateral_displacements_m(scenario)
     q, v = [], []
     pinion = 0.0
     for k, st in enumerate(scenario.stages):
         delta = static_deflection_m(scenario, k, pinion, forces[k])
-        wheel = (st.pinion.base_radius_m * pinion - delta) / st.wheel.base_radius_m
+        pname, wname = gear_names(k)
+        n, _, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
+        centres = (lateral.get(pname, np.zeros(2)) - lateral.get(wname, np.zeros(2))) @ n
+        wheel = (st.pinion.base_radius_m * pinion - delta + centres) / st.wheel.base_radius_m
         q += [pinion, wheel]
         v += [op["pinion_speed_rad_s"][k], op["wheel_speed_rad_s"][k]]
         if k + 1 < len(scenario.stages):

@@ -20,11 +20,19 @@ from scipy.interpolate import CubicHermiteSpline
 from .. import __version__
 from ..model import Scenario, scenario_to_dict
 from ..physics import load_torque_at, motor_torque_at, synchronous_angle_at
+from ..physics.bearings import LinearBearing
+from ..physics.lateral import mesh_directions
 from ..physics.mesh import mesh_contact_series, mesh_parameters_from_scenario, mesh_phase_series
 from ..physics.motor import pack_drive_parameters
 from ..result import Result
 from .build import BuiltSystem, build_muller, build_torsional
-from .layout import gear_names, initial_state, mesh_frequency_hz, torsional_layout
+from .layout import (
+    gear_names,
+    initial_state,
+    mesh_frequency_hz,
+    static_lateral_displacements_m,
+    torsional_layout,
+)
 
 SOLVER_TYPES = {
     name: getattr(exu.DynamicSolverType, name) for name in ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")
@@ -134,7 +142,11 @@ def build(scenario: Scenario) -> tuple[BuiltSystem, np.ndarray, np.ndarray]:
         raise SimulationError(f"cannot set the initial state: {exc}") from None
     if scenario.meta.scene == "muller":
         return build_muller(scenario, q0, v0), q0, v0
-    return build_torsional(torsional_layout(scenario), q0, v0), q0, v0
+    try:
+        lateral_u0 = static_lateral_displacements_m(scenario)
+    except ValueError as exc:
+        raise SimulationError(f"cannot set the initial bearing displacements: {exc}") from None
+    return build_torsional(torsional_layout(scenario), q0, v0, lateral_u0=lateral_u0), q0, v0
 
 
 def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
@@ -175,7 +187,7 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
 
 def _stored(mbs, sensor_ids: list[int]) -> tuple[np.ndarray, np.ndarray]:
     data = [mbs.GetSensorStoredData(s) for s in sensor_ids]
-    return data[0][:, 0], np.stack([d[:, 1] for d in data])
+    return data[0][:, 0], np.concatenate([d[:, 1:].T for d in data])
 
 
 def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
@@ -209,6 +221,8 @@ def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
         signals.update(_muller_signals(scenario, t, qs[0], vs[0], acc[0]))
     else:
         signals.update(_torsional_signals(scenario, built.dof_names, t, qs, vs, acc))
+        if scenario.is_lateral:
+            signals.update(_lateral_signals(scenario, built.dof_names, qs, vs, acc, signals))
     stats = {
         "steps": n_steps,
         "method": scenario.solver.method,
@@ -260,6 +274,8 @@ def _mesh_signals(pinion_angle, delta, delta_rate, P, rated_force_N: float) -> d
 def _torsional_signals(scenario, names, t, q, v, a) -> dict[str, np.ndarray]:
     out = {}
     for k, name in enumerate(names):
+        if name.endswith(("_x", "_y")) and name[:-2] in names:
+            continue  # a lateral gear's centre: see _lateral_signals
         out[f"{name}_angle_rad"] = q[k]
         out[f"{name}_speed_rad_s"] = v[k]
         out[f"{name}_accel_rad_s2"] = a[k]
@@ -270,15 +286,51 @@ def _torsional_signals(scenario, names, t, q, v, a) -> dict[str, np.ndarray]:
         ip, iw = names.index(pname), names.index(wname)
         r1, r2 = st.pinion.base_radius_m, st.wheel.base_radius_m
         P = mesh_parameters_from_scenario(scenario, k)
-        sig = _mesh_signals(
-            q[ip], r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw], P, scenario.stage_rated_force_N(k)
-        )
+        delta, rate = r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw]
+        n, _, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
+        for name, sign in ((pname, 1.0), (wname, -1.0)):
+            if f"{name}_x" in names:
+                ix, iy = names.index(f"{name}_x"), names.index(f"{name}_y")
+                delta = delta + sign * (q[ix] * n[0] + q[iy] * n[1])
+                rate = rate + sign * (v[ix] * n[0] + v[iy] * n[1])
+        sig = _mesh_signals(q[ip], delta, rate, P, scenario.stage_rated_force_N(k))
         sig["mesh_frequency_hz"] = st.pinion.teeth * v[ip] / (2 * math.pi)
         prefix = "" if k == 0 else f"stage_{k + 1}_"
         out.update({prefix + key: value for key, value in sig.items()})
     D = pack_drive_parameters(scenario)
     out["motor_torque_Nm"] = np.array([motor_torque_at(tk, w, D) for tk, w in zip(t, v[0], strict=True)])
     out["load_torque_Nm"] = np.array([load_torque_at(tk, D) for tk in t])
+    return out
+
+
+def _lateral_signals(scenario, names, q, v, a, signals) -> dict[str, np.ndarray]:
+    """Centre motion, bearing force to the housing and housing acceleration of every lateral gear
+    (docs/scenario.md, 'Signals'): a fixed direction passes the mesh force component on."""
+    out = {}
+    for k, st in enumerate(scenario.stages):
+        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        F, T = signals[prefix + "mesh_force_N"], signals[prefix + "friction_force_N"]
+        n, m, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
+        for name, gear, sign in zip(gear_names(k), (st.pinion, st.wheel), (1.0, -1.0), strict=True):
+            if gear.lateral == "none":
+                continue
+            ix, iy = names.index(f"{name}_x"), names.index(f"{name}_y")
+            u, du = q[[ix, iy]], v[[ix, iy]]
+            law = gear.bearing.law()
+            if isinstance(law, LinearBearing):
+                f_b = law.force_N(u, du)
+            else:
+                f_b = np.array([law.force_N(u[:, s], du[:, s]) for s in range(u.shape[1])]).T
+            for d, axis in enumerate("xy"):
+                if d in gear.free_directions:
+                    out[f"{name}_{axis}_m"] = u[d]
+                    out[f"{name}_{axis}_velocity_m_s"] = du[d]
+                    out[f"{name}_{axis}_accel_m_s2"] = a[[ix, iy][d]]
+                    force = -f_b[d]
+                else:
+                    force = sign * (-F * n[d] + T * m[d])  # mesh force on the gear, passed on
+                out[f"{name}_bearing_force_{axis}_N"] = force
+                out[f"{name}_housing_accel_{axis}_m_s2"] = force / gear.bearing.housing_mass_kg
     return out
 
 

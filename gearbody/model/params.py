@@ -92,6 +92,13 @@ def _convert(value: Any, tp: Any, ctx: _Ctx, meta: typing.Mapping[str, Any]) -> 
         if value is None:
             return None
         return _convert(value, args[0], ctx, meta)
+    if tp is dict or origin is dict:
+        if not isinstance(value, dict):
+            ctx.fail(value, "must be a table of name = number")
+        out = {}
+        for key, v in value.items():
+            out[key] = _convert(v, float, ctx.child(key), {})
+        return out
     if dataclasses.is_dataclass(tp):
         if not isinstance(value, dict):
             ctx.fail(value, f"must be a table of {_type_name(tp)} keys")
@@ -176,4 +183,6 @@ def to_dict(obj: Any) -> Any:
         return out
     if isinstance(obj, (list, tuple)):
         return [to_dict(v) for v in obj]
+    if isinstance(obj, dict):
+        return {k: to_dict(v) for k, v in obj.items()}
     return obj

@@ -41,11 +41,61 @@ class Shaft:
 
 
 @dataclass(frozen=True, kw_only=True)
+class Bearing:
+    """Bearing between a gear centre and the housing: a registered law (gearbody.physics.bearings)
+    with its keyword parameters, and the effective housing mass seen at this bearing."""
+
+    kind: str = param("linear", doc="registered bearing law, e.g. 'linear' or 'hertzian'")
+    housing_mass_kg: float = param(50.0, gt=0, doc="effective housing mass for the housing acceleration")
+    parameters: dict[str, float] = param(default_factory=dict, doc="keyword parameters of the law")
+
+    def __post_init__(self) -> None:
+        self.law()  # refuse unknown kinds and bad parameters before anything runs
+
+    def law(self):
+        """The bearing law object (has ``force_N(displacement_m, velocity_m_s)``)."""
+        from ..physics.bearings import BEARINGS, make_bearing
+
+        if self.kind not in BEARINGS:
+            raise ScenarioError(
+                f"bearing.kind = {self.kind!r}: not a registered bearing law; registered: "
+                f"{', '.join(sorted(BEARINGS))}"
+            )
+        try:
+            return make_bearing(self.kind, **self.parameters)
+        except TypeError as exc:
+            import inspect
+
+            names = list(inspect.signature(BEARINGS[self.kind]).parameters)
+            raise ScenarioError(
+                f"bearing.parameters = {self.parameters}: {exc}; the {self.kind!r} law takes {', '.join(names)}"
+            ) from None
+        except ValueError as exc:
+            raise ScenarioError(f"bearing.parameters: {exc}") from None
+
+
+LATERAL = ("none", "y", "xy")
+
+
+@dataclass(frozen=True, kw_only=True)
 class Gear:
     teeth: int = param(ge=6, doc="number of teeth z")
     base_radius_m: float = param(gt=0, doc="base radius r_b")
     inertia_kg_m2: float = param(gt=0, doc="polar moment of inertia")
     mass_kg: float = param(gt=0, doc="mass (lateral models)")
+    lateral: str = param("none", choices=LATERAL, doc="free translations of the gear centre")
+    bearing: Bearing | None = param(None, doc="bearing to the housing (required when lateral)")
+
+    def __post_init__(self) -> None:
+        if self.lateral != "none" and self.bearing is None:
+            raise ScenarioError(
+                f"lateral = {self.lateral!r} needs a bearing table (kind, housing_mass_kg, parameters)"
+            )
+
+    @property
+    def free_directions(self) -> tuple[int, ...]:
+        """Indices (0 = x, 1 = y) of the free centre translations."""
+        return {"none": (), "y": (1,), "xy": (0, 1)}[self.lateral]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -70,8 +120,20 @@ class Mesh:
     backlash_um: float = param(0.0, ge=0, doc="l_u: half-width of the dead zone of eq. (4)")
     pressure_angle_deg: float = param(20.0, gt=0, lt=45, doc="operating pressure angle")
     pitch_point_phase: float = param(0.5, ge=0, le=1, doc="mesh phase where friction reverses")
+    centre_line_deg: float = param(
+        0.0, ge=-360, le=360, doc="direction from pinion to wheel centre (lateral models)"
+    )
+    line_of_action_deg: float = param(
+        -90.0, ge=-360, le=360, doc="direction of the mesh force on the wheel (lateral models)"
+    )
 
     def __post_init__(self) -> None:
+        if abs(self.line_of_action_normal_projection) < 0.5:
+            raise ScenarioError(
+                f"line_of_action_deg = {self.line_of_action_deg:g} with centre_line_deg = "
+                f"{self.centre_line_deg:g}: the line of action must lie within 60 deg of the normal "
+                "of the centre line (for pressure angle alpha: centre_line_deg -+ (90 - alpha))"
+            )
         if self.stiffness_profile == "table":
             ph, k = self.table_phase, self.table_stiffness_N_per_m
             if len(ph) < 2 or len(ph) != len(k):
@@ -83,6 +145,12 @@ class Mesh:
                 raise ScenarioError(f"table_phase = {list(ph)}: must increase strictly within [0, 1)")
             if any(v < 0 for v in k):
                 raise ScenarioError(f"table_stiffness_N_per_m = {list(k)}: values must be >= 0")
+
+    @property
+    def line_of_action_normal_projection(self) -> float:
+        """n . e_perp: n the line of action, e_perp the normal of the centre line."""
+        lam, gam = math.radians(self.line_of_action_deg), math.radians(self.centre_line_deg)
+        return math.cos(lam) * -math.sin(gam) + math.sin(lam) * math.cos(gam)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -251,6 +319,13 @@ class Scenario:
                     raise ScenarioError(
                         f"{where_t}damaged_teeth: tooth = {t.tooth} on the {t.gear}: must be < its {z} teeth"
                     )
+        if self.meta.scene in ("muller", "two-wheel"):
+            for name in ("pinion", "wheel"):
+                if getattr(d, name).lateral != "none":
+                    raise ScenarioError(
+                        f"design.{name}.lateral = {getattr(d, name).lateral!r}: scene "
+                        f"{self.meta.scene!r} has no lateral motion; use 'one-stage' or 'train'"
+                    )
         if self.solver.output_rate_hz * self.operation.t_end_s < 2:
             raise ScenarioError(
                 f"solver.output_rate_hz = {self.solver.output_rate_hz}: gives fewer than 2 "
@@ -274,6 +349,11 @@ class Scenario:
                 damaged_teeth=self.condition.damaged_teeth,
             ),
         )
+
+    @property
+    def is_lateral(self) -> bool:
+        """True when any gear moves laterally on its bearing."""
+        return any(g.lateral != "none" for st in self.stages for g in (st.pinion, st.wheel))
 
     @property
     def gear_ratio(self) -> float:
