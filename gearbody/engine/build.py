@@ -123,7 +123,11 @@ def build_torsional(
     for k, b in enumerate(layout.inertias):
         if b.lateral is None:
             nd = mbs.AddNode(
-                Node1D(referenceCoordinates=[0.0], initialCoordinates=[float(q0[k])], initialVelocities=[float(v0[k])])
+                Node1D(
+                    referenceCoordinates=[0.0],
+                    initialCoordinates=[float(q0[k])],
+                    initialVelocities=[float(v0[k])],
+                )
             )
             mbs.AddObject(ObjectRotationalMass1D(nodeNumber=nd, inertia=b.inertia_kg_m2))
         else:

@@ -139,7 +139,11 @@ def _support(gear) -> LateralSupport | None:
     if gear.lateral == "none":
         return None
     return LateralSupport(
-        gear.free_directions, gear.mass_kg, gear.bearing.law(), gear.bearing.kind, gear.bearing.housing_mass_kg
+        gear.free_directions,
+        gear.mass_kg,
+        gear.bearing.law(),
+        gear.bearing.kind,
+        gear.bearing.housing_mass_kg,
     )
 
 

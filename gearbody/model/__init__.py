@@ -4,11 +4,11 @@ from .io import dump_scenario, load_scenario, parse_override, scenario_to_dict
 from .params import ScenarioError
 from .scenario import (
     SCENES,
+    Bearing,
     Condition,
     DamagedTooth,
     Design,
     ErrorMode,
-    Bearing,
     Gear,
     Machine,
     Mesh,

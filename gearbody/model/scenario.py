@@ -68,7 +68,8 @@ class Bearing:
 
             names = list(inspect.signature(BEARINGS[self.kind]).parameters)
             raise ScenarioError(
-                f"bearing.parameters = {self.parameters}: {exc}; the {self.kind!r} law takes {', '.join(names)}"
+                f"bearing.parameters = {self.parameters}: {exc}; "
+                f"the {self.kind!r} law takes {', '.join(names)}"
             ) from None
         except ValueError as exc:
             raise ScenarioError(f"bearing.parameters: {exc}") from None

@@ -107,5 +107,7 @@ def tangent_stiffness_N_per_m(law, displacement_m, relative_step: float = 1e-6) 
     for d in range(2):
         du = np.zeros(2)
         du[d] = h
-        K[:, d] = -(np.asarray(law.force_N(u0 + du, np.zeros(2))) - law.force_N(u0 - du, np.zeros(2))) / (2 * h)
+        K[:, d] = -(np.asarray(law.force_N(u0 + du, np.zeros(2))) - law.force_N(u0 - du, np.zeros(2))) / (
+            2 * h
+        )
     return K
