@@ -147,11 +147,12 @@ def cmd_modes(args) -> int:
     print(f"{scenario.meta.title}")
     print(f"linearised at mean mesh stiffness {k} N/m; DOFs: {', '.join(modes.dof_names)}")
     speeds = resonance_speeds_rad_s(modes, z1, args.harmonics)
-    head = "".join(f"  w({h}f_z) rad/s  " for h in range(1, args.harmonics + 1))
-    print(f"{'mode':>4} {'f_n Hz':>12}  {'dominant DOF':<12}{head}")
+    head = "".join(f"{f'w({h}f_z) rad/s':>18}" for h in range(1, args.harmonics + 1))
+    width = max(len(modes.label(m)) for m in range(len(modes.frequencies_hz))) + 2
+    print(f"{'mode':>4} {'f_n Hz':>12}  {'dominant motion (share of kinetic energy)':<{width}}{head}")
     for m, f in enumerate(modes.frequencies_hz):
         cols = "".join(f"{'-' if math.isnan(s) else f'{s:.2f}':>18}" for s in speeds[:, m])
-        print(f"{m + 1:>4} {f:12.3f}  {modes.dominant_dof(m):<12}{cols}")
+        print(f"{m + 1:>4} {f:12.3f}  {modes.label(m):<{width}}{cols}")
     print(f"(w(k f_z) = pinion speed at which the k-th mesh harmonic z1 w k / 2 pi meets f_n; z1 = {z1})")
     return 0
 

@@ -147,12 +147,19 @@ def _support(gear) -> LateralSupport | None:
     )
 
 
-def static_lateral_displacements_m(scenario: Scenario) -> dict[str, np.ndarray]:
-    """Initial centre displacement (x, y) of every lateral gear: 0 from rest; at the static bearing
-    deflection under the steady mesh force (friction ignored) for 'steady'."""
+def static_lateral_displacements_m(
+    scenario: Scenario, load_fraction: float | None = None
+) -> dict[str, np.ndarray]:
+    """Centre displacement (x, y) of every lateral gear at static equilibrium (friction ignored).
+
+    Default: the initial state (0 from rest; under the steady mesh forces for 'steady'). With
+    ``load_fraction``: under that fraction of the rated mesh forces (modes use 1.0).
+    """
     out: dict[str, np.ndarray] = {}
     forces = None
-    if scenario.operation.initial_state == "steady":
+    if load_fraction is not None:
+        forces = [load_fraction * scenario.stage_rated_force_N(k) for k in range(len(scenario.stages))]
+    elif scenario.operation.initial_state == "steady":
         forces = steady_operating_point(scenario)["mesh_force_N"]
     for k, st in enumerate(scenario.stages):
         n, _, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)

@@ -86,16 +86,19 @@ def static_bearing_displacement_m(law, force_on_gear_N, free_directions: tuple[i
 
     free = list(free_directions)
 
-    def residual(x):
-        u = np.zeros(2)
-        u[free] = x
-        return (np.asarray(law.force_N(u, np.zeros(2)), float) + f)[free]
+    scale_N = float(np.hypot(*f))
 
-    sol = root(residual, np.full(len(free), 1e-6), method="hybr", options={"xtol": 1e-14})
-    if not sol.success:
+    def residual(x_um):  # micrometres and relative force keep the problem well scaled
+        u = np.zeros(2)
+        u[free] = x_um * 1e-6
+        return (np.asarray(law.force_N(u, np.zeros(2)), float) + f)[free] / scale_N
+
+    guess = f[free] / scale_N  # 1 um along the force
+    sol = root(residual, guess, method="lm", options={"xtol": 1e-15, "ftol": 1e-15})
+    if not sol.success or np.max(np.abs(residual(sol.x))) > 1e-9:
         raise ValueError(f"no static equilibrium of the bearing law {law!r} under {f} N: {sol.message}")
     u = np.zeros(2)
-    u[free] = sol.x
+    u[free] = sol.x * 1e-6
     return u
 
 
