@@ -14,6 +14,7 @@ def test_scene_agrees_with_independent_reference_within_half_a_percent(scene):
     for case in cases(scene, short=True):
         r = compare_case(scene, case, short=True)
         assert r.max_error_percent <= 0.5, (scene, case.name, r.max_error_percent)
+        assert not r.bearing_error_percent > 1.0, (scene, case.name, r.bearing_error_percent)
         if case.must_separate:
             assert r.kd_max > 2.0 and r.separated_fraction > 0.05
 
@@ -27,6 +28,23 @@ def test_comparison_detects_a_model_difference():
     other["production"]["error_mode"]["e_um"] = 12.0
     ref = simulate_reference(other, t_eval=res.time_s)
     assert np.max(np.abs(res.mesh_force - ref["mesh_force_N"])) / sc.rated_mesh_force_N > 0.005
+
+
+def test_bearing_comparison_detects_a_model_difference():
+    """A reference whose wheel bearing is 10 % stiffer in y differs by more than the 1 % bearing limit."""
+    from gearbody.validation.compare import bearing_force_errors_percent
+    from gearbody.validation.reference_lateral import simulate_reference_lateral
+
+    sc = load_scenario("lateral-8dof", [*cases("lateral-8dof")[0].overrides, "operation.t_end_s=0.03"])
+    res = simulate(sc)
+    same = bearing_force_errors_percent(
+        res, simulate_reference_lateral(scenario_to_dict(sc), t_eval=res.time_s)
+    )
+    assert max(same.values()) < 0.01
+    other = scenario_to_dict(sc)
+    other["design"]["wheel"]["bearing"]["parameters"]["stiffness_y_N_per_m"] *= 1.1
+    changed = bearing_force_errors_percent(res, simulate_reference_lateral(other, t_eval=res.time_s))
+    assert changed["wheel_y"] > 1.0
 
 
 def test_validate_command_prints_a_table_and_reports_failure(capsys):
