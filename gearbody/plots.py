@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike
 from gearbody.analysis.dynamic_factor import INSTABILITY_KD, FoldedSignal
 from gearbody.analysis.spectrum import Spectrum, mesh_harmonics
 
-__all__ = ["harmonic_labels", "plot_kd_folded", "plot_kd_time", "plot_spectrum"]
+__all__ = ["harmonic_labels", "plot_kd_folded", "plot_kd_time", "plot_signals", "plot_spectrum"]
 
 PathLike = str | os.PathLike[str]
 DEFAULT_SIZE_PX: tuple[int, int] = (1000, 600)
@@ -79,6 +79,31 @@ def plot_kd_time(
         ax.set_title(title)
     if kd_threshold is not None:
         ax.legend(loc="upper left")
+    ax.grid(True, alpha=0.3)
+    return _save(fig, path, dpi)
+
+
+def plot_signals(
+    time_s: ArrayLike,
+    signals: Mapping[str, ArrayLike],
+    path: PathLike,
+    title: str = "",
+    ylabel: str = "",
+    size_px: tuple[int, int] = DEFAULT_SIZE_PX,
+    dpi: int = 100,
+) -> Path:
+    """Several signals of one unit against time [s], one line each, labelled by their names."""
+    fig = _figure(size_px, dpi)
+    ax = fig.add_subplot()
+    t = np.asarray(time_s, dtype=float)
+    for name, values in signals.items():
+        ax.plot(t, np.asarray(values, dtype=float), linewidth=0.6, label=name)
+    ax.set_xlabel("Time t [s]")
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title)
+    if signals:
+        ax.legend(loc="upper left", fontsize="small")
     ax.grid(True, alpha=0.3)
     return _save(fig, path, dpi)
 

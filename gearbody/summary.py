@@ -30,9 +30,19 @@ def pinion_angle(result: Result) -> np.ndarray:
 
 
 def vibration_signal(result: Result) -> tuple[str, np.ndarray]:
-    """The acceleration signal whose spectrum is shown: pinion angular acceleration (Muller: deflection)."""
+    """The acceleration signal whose spectrum is shown: the housing acceleration at the first lateral
+    gear's bearing along the line of action's dominant axis (what an accelerometer there reads);
+    otherwise the pinion's angular acceleration (Muller: the deflection's)."""
+    for name in ("pinion_housing_accel_y_m_s2", "wheel_housing_accel_y_m_s2"):
+        if name in result and f"{name.split('_housing')[0]}_y_m" in result:
+            return name, result[name]
     name = "pinion_accel_rad_s2" if "pinion_accel_rad_s2" in result else "deflection_accel_m_s2"
     return name, result[name]
+
+
+def bearing_gears(result: Result) -> list[str]:
+    """Names of the gears with bearing-force signals (lateral gears)."""
+    return sorted({k.split("_bearing_force_")[0] for k in result.signals if "_bearing_force_" in k})
 
 
 def summarize(result: Result) -> dict[str, Any]:
@@ -64,6 +74,20 @@ def summarize(result: Result) -> dict[str, Any]:
         "solver_steps": int(stats.get("steps", 0)),
         "solver_rejected_steps": int(stats.get("rejected_steps", 0)),
         "seed": result.meta.get("seed"),
+        **{
+            f"{gear}_bearing_force_{axis}_max_N": float(
+                np.max(np.abs(result[f"{gear}_bearing_force_{axis}_N"]))
+            )
+            for gear in bearing_gears(result)
+            for axis in "xy"
+        },
+        **{
+            f"{gear}_housing_accel_{axis}_rms_final_m_s2": float(
+                np.std(result[f"{gear}_housing_accel_{axis}_m_s2"][win])
+            )
+            for gear in bearing_gears(result)
+            for axis in "xy"
+        },
     }
 
 
@@ -107,4 +131,19 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
             log_amplitude=True,
         )
     )
+    gears = bearing_gears(result)
+    if gears:
+        paths.append(
+            plots.plot_signals(
+                result.time_s,
+                {
+                    f"{gear} {axis}": result[f"{gear}_bearing_force_{axis}_N"]
+                    for gear in gears
+                    for axis in "xy"
+                },
+                out / "bearing_forces.png",
+                title=f"{title}: forces on the housing at the bearings",
+                ylabel="bearing force [N]",
+            )
+        )
     return paths

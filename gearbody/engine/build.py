@@ -331,6 +331,15 @@ def _lateral_mesh_user_function(m, bp: Inertia, bw: Inertia, idx: np.ndarray):
 
 def _bearing_user_function(law, free_directions: tuple[int, ...]):
     mask = np.array([float(d in free_directions) for d in (0, 1)])
+    mx, my = float(mask[0]), float(mask[1])
+    if hasattr(law, "force_xy"):
+        force_xy = law.force_xy
+
+        def bearing_force_xy(mbs, t, itemNumber, q, q_t):
+            fx, fy = force_xy(q[0] * mx, q[1] * my, q_t[0] * mx, q_t[1] * my)
+            return [fx * mx, fy * my, 0.0]
+
+        return bearing_force_xy
 
     def bearing_force(mbs, t, itemNumber, q, q_t):
         f = np.asarray(law.force_N(np.asarray(q[:2]) * mask, np.asarray(q_t[:2]) * mask), float) * mask

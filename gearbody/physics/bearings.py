@@ -14,8 +14,10 @@ to scenarios:
 
     register_bearing("mine", MyBearing)
 
-The engine (issue 3) wraps any law in one user-function connector between gear and housing; it never
-needs to know which law it is.
+The engine wraps any law in one user-function connector between gear and housing; it never needs
+to know which law it is. A law may also offer ``force_xy(ux, uy, vx, vy) -> (fx, fy)`` on plain floats,
+which the engine then calls instead (cheaper per call); the linear law is built from Exudyn's own
+spring-dampers.
 """
 
 from __future__ import annotations
@@ -94,17 +96,22 @@ class HertzianBearing:
             raise ValueError(f"HertzianBearing.damping_Ns_per_m = {self.damping_Ns_per_m!r}: must be >= 0")
 
     def force_N(self, displacement_m, velocity_m_s) -> np.ndarray:
-        u = np.asarray(displacement_m, float)
-        v = np.asarray(velocity_m_s, float)
-        r = math.hypot(u[0], u[1])
+        u, v = displacement_m, velocity_m_s
+        return np.array(self.force_xy(float(u[0]), float(u[1]), float(v[0]), float(v[1])))
+
+    def force_xy(self, ux: float, uy: float, vx: float, vy: float) -> tuple[float, float]:
+        """Scalar form of :meth:`force_N` (the engine calls it when a law has one: fewer conversions)."""
+        r = math.hypot(ux, uy)
         penetration = r - self.radial_clearance_m
         if penetration <= 0.0 or r == 0.0:
-            return np.zeros(2)
-        e = u / r
+            return 0.0, 0.0
+        ex, ey = ux / r, uy / r
         radial = self.contact_stiffness_N_per_m_n * penetration**self.exponent + self.damping_Ns_per_m * (
-            v @ e
+            vx * ex + vy * ey
         )
-        return -max(radial, 0.0) * e  # a bearing pushes, it never pulls
+        if radial <= 0.0:
+            return 0.0, 0.0  # a bearing pushes, it never pulls
+        return -radial * ex, -radial * ey
 
     def potential_J(self, displacement_m) -> float:
         """Elastic energy stored in the contact (for checks): k_b p^(n+1) / (n+1)."""
