@@ -6,7 +6,7 @@ diagnostics*, Mechanical Systems and Signal Processing 15(5), 2001.
 
 __version__ = "0.1.0"
 
-from .model import Scenario, ScenarioError, dump_scenario, load_scenario  # noqa: E402
+from .model import Scenario, ScenarioError, dump_scenario, load_scenario, scenario_to_dict  # noqa: E402
 from .result import Result  # noqa: E402
 
 
@@ -19,4 +19,13 @@ def simulate(scenario, *, progress: bool = False) -> Result:
     return _simulate(scenario, progress=progress)
 
 
-__all__ = ["Result", "Scenario", "ScenarioError", "__version__", "dump_scenario", "load_scenario", "simulate"]
+__all__ = [
+    "Result",
+    "Scenario",
+    "ScenarioError",
+    "__version__",
+    "dump_scenario",
+    "load_scenario",
+    "scenario_to_dict",
+    "simulate",
+]
