@@ -6,6 +6,7 @@ change of condition (damaged teeth, friction). See ``docs/scenario.md`` for ever
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -50,7 +51,10 @@ class Bearing:
     parameters: dict[str, float] = param(default_factory=dict, doc="keyword parameters of the law")
 
     def __post_init__(self) -> None:
-        self.law()  # refuse unknown kinds and bad parameters before anything runs
+        law = self.law()  # refuse unknown kinds and bad parameters before anything runs
+        if dataclasses.is_dataclass(law):  # resolve the law's defaults into the scenario
+            resolved = {f.name: float(getattr(law, f.name)) for f in dataclasses.fields(law)}
+            object.__setattr__(self, "parameters", resolved)
 
     def law(self):
         """The bearing law object (has ``force_N(displacement_m, velocity_m_s)``)."""
