@@ -32,6 +32,17 @@ RATED = [
 ]
 
 
+def _reference(scenario):
+    """The independent reference for the scene: torsional, or with gears on bearings."""
+    if scenario.is_lateral:
+        from gearbody.validation.reference_lateral import simulate_reference_lateral
+
+        return simulate_reference_lateral
+    from gearbody.validation.reference import simulate_reference
+
+    return simulate_reference
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scene", default="one-stage")
@@ -66,20 +77,17 @@ def main() -> None:
         f"atol {sc.solver.absolute_tolerance:g}) | {wall / args.t_end:.3f} | {stats['steps']} | "
         f"{stats['rejected_steps']} | best of {args.repeat}; warm-up incl. numba load {first_build:.2f} s |",
     ]
+    simulate_reference = _reference(sc)
     if args.reference:
-        from gearbody.validation.reference import simulate_reference
-
         t0 = time.perf_counter()
         ref = simulate_reference(scenario_to_dict(sc), t_eval=res.time_s)
         wref = time.perf_counter() - t0
         err = np.max(np.abs(ref["mesh_force_N"] - res.mesh_force)) / sc.rated_mesh_force_N * 100
         lines.append(
-            f"| scipy reference (validation/reference.py) | {wref / args.t_end:.3f} | - | - | "
+            f"| scipy reference ({simulate_reference.__module__}) | {wref / args.t_end:.3f} | - | - | "
             f"max dF {err:.3f} % of F_rated vs gearbody; ratio reference/gearbody {wref / wall:.1f} |"
         )
     if args.sweep:
-        from gearbody.validation.reference import simulate_reference
-
         ref = simulate_reference(scenario_to_dict(sc), t_eval=res.time_s)
         lines += [
             "",
