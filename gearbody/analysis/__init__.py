@@ -12,11 +12,13 @@ from gearbody.analysis.dynamic_factor import (
 )
 from gearbody.analysis.spectrum import (
     Peak,
+    SidebandLine,
     Spectrum,
     amplitude_spectrum,
     mesh_harmonics,
     peak_at,
     peak_near,
+    sideband_lines,
 )
 
 __all__ = [
@@ -24,6 +26,7 @@ __all__ = [
     "FoldedSignal",
     "Peak",
     "SeparationStats",
+    "SidebandLine",
     "Spectrum",
     "amplitude_spectrum",
     "fold_over_mesh_period",
@@ -33,5 +36,6 @@ __all__ = [
     "peak_near",
     "periods_stats",
     "separation_stats",
+    "sideband_lines",
     "unstable",
 ]

@@ -13,7 +13,16 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.signal import detrend as _detrend
 from scipy.signal import get_window
 
-__all__ = ["Peak", "Spectrum", "amplitude_spectrum", "mesh_harmonics", "peak_at", "peak_near"]
+__all__ = [
+    "Peak",
+    "SidebandLine",
+    "Spectrum",
+    "amplitude_spectrum",
+    "mesh_harmonics",
+    "peak_at",
+    "peak_near",
+    "sideband_lines",
+]
 
 
 @dataclass(frozen=True)
@@ -122,3 +131,71 @@ def peak_near(spectrum: Spectrum, f_hz: float, tol_hz: float) -> Peak:
 def peak_at(spectrum: Spectrum, f_hz: float, tol_hz: float) -> float:
     """Largest amplitude [signal units] among bins within tol_hz [Hz] of f_hz [Hz]."""
     return peak_near(spectrum, f_hz, tol_hz).amplitude
+
+
+@dataclass(frozen=True)
+class SidebandLine:
+    """A line of the family k f_c + n f_m (carrier harmonic k, sideband order n) found in a spectrum."""
+
+    label: str
+    """E.g. "f_z1+2f_z2"."""
+    expected_hz: float
+    """Where kinematics puts it, k f_c + n f_m [Hz]."""
+    found_hz: float
+    """Frequency of the local maximum next to it [Hz]."""
+    amplitude: float
+    """Its amplitude [signal units]."""
+    floor: float
+    """Median amplitude of the band +- half a spacing around it [signal units]."""
+    is_peak: bool
+    """The found bin is a local maximum (higher than both neighbours)."""
+
+    @property
+    def prominence_db(self) -> float:
+        """Amplitude over the local floor, dB."""
+        return float(20.0 * np.log10(self.amplitude / self.floor)) if self.floor > 0 else float("inf")
+
+
+def sideband_lines(
+    spectrum: Spectrum,
+    carrier_hz: float,
+    modulation_hz: float,
+    carrier_orders: tuple[int, ...] = (1, 2, 3),
+    sideband_orders: tuple[int, ...] = (-2, -1, 1, 2),
+    search_bins: int = 2,
+    carrier_symbol: str = "f_z1",
+    modulation_symbol: str = "f_z2",
+) -> list[SidebandLine]:
+    """Lines at k f_c + n f_m, e.g. the first stage's mesh harmonics modulated by the second stage's
+    mesh frequency (the paper's Fig. 20).
+
+    Each line is the largest bin within ``search_bins`` bins of k f_c + n f_m; its floor is the median
+    amplitude over +- f_m / 2 around it, so a line is visible when ``prominence_db`` is well above 0.
+    """
+    if not (carrier_hz > 0 and modulation_hz > 0):
+        raise ValueError(f"carrier_hz and modulation_hz must be positive, got {carrier_hz}, {modulation_hz}")
+    f, a = spectrum.frequency_hz, spectrum.amplitude
+    df = spectrum.resolution_hz
+    out = []
+    for k in carrier_orders:
+        for n in sideband_orders:
+            target = k * carrier_hz + n * modulation_hz
+            if not 0 < target < f[-1]:
+                continue
+            centre = int(round(target / df))
+            lo, hi = max(centre - search_bins, 1), min(centre + search_bins, f.size - 2)
+            best = lo + int(np.argmax(a[lo : hi + 1]))
+            band = np.abs(f - target) <= 0.5 * modulation_hz
+            carrier = f"{k if k > 1 else ''}{carrier_symbol}"
+            side = f"{'+' if n > 0 else '-'}{abs(n) if abs(n) > 1 else ''}{modulation_symbol}"
+            out.append(
+                SidebandLine(
+                    label=carrier + side,
+                    expected_hz=float(target),
+                    found_hz=float(f[best]),
+                    amplitude=float(a[best]),
+                    floor=float(np.median(a[band])),
+                    is_peak=bool(a[best] > a[best - 1] and a[best] > a[best + 1]),
+                )
+            )
+    return out
