@@ -35,7 +35,8 @@ def test_bearing_comparison_detects_a_model_difference():
     from gearbody.validation.compare import bearing_force_errors_percent
     from gearbody.validation.reference_lateral import simulate_reference_lateral
 
-    sc = load_scenario("lateral-8dof", [*cases("lateral-8dof")[0].overrides, "operation.t_end_s=0.03"])
+    overrides = [*cases("lateral-8dof")[0].overrides, "operation.t_end_s=0.03", "solver.anti_aliasing=false"]
+    sc = load_scenario("lateral-8dof", overrides)
     res = simulate(sc)
     same = bearing_force_errors_percent(
         res, simulate_reference_lateral(scenario_to_dict(sc), t_eval=res.time_s)

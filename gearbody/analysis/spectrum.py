@@ -187,7 +187,8 @@ def sideband_lines(
             best = lo + int(np.argmax(a[lo : hi + 1]))
             band = np.abs(f - target) <= 0.5 * modulation_hz
             carrier = f"{k if k > 1 else ''}{carrier_symbol}"
-            side = f"{'+' if n > 0 else '-'}{abs(n) if abs(n) > 1 else ''}{modulation_symbol}"
+            order = f"{abs(n) if abs(n) > 1 else ''}{modulation_symbol}"
+            side = "" if n == 0 else ("+" if n > 0 else "-") + order
             out.append(
                 SidebandLine(
                     label=carrier + side,

@@ -18,6 +18,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
 from .. import __version__
+from ..analysis.antialias import band_limited_samples
 from ..model import Scenario, scenario_to_dict
 from ..physics import load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
@@ -33,6 +34,7 @@ from .layout import (
     static_lateral_displacements_m,
     torsional_layout,
 )
+from .sampling import OVERSAMPLING, is_band_limited, mesh_jump_times
 
 SOLVER_TYPES = {
     name: getattr(exu.DynamicSolverType, name) for name in ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")
@@ -212,17 +214,27 @@ def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
     t_steps, q, v, a = t_steps[keep], q[:, keep], v[:, keep], a[:, keep]
     a[:, 0] = a[:, 1] if a.shape[1] > 1 else 0.0
     rate = scenario.solver.output_rate_hz
-    t = np.arange(math.floor(t_end * rate + 1e-9) + 1) / rate
-    qs = CubicHermiteSpline(t_steps, q, v, axis=1)(t)
-    vs = CubicHermiteSpline(t_steps, v, a, axis=1)(t)
-    acc = np.stack([np.interp(t, t_steps, row) for row in a])
+    n_out = math.floor(t_end * rate + 1e-9) + 1
+    position = CubicHermiteSpline(t_steps, q, v, axis=1)
+    velocity = CubicHermiteSpline(t_steps, v, a, axis=1)
+
+    def states(times):
+        return position(times), velocity(times), np.stack([np.interp(times, t_steps, row) for row in a])
+
+    band_limit = scenario.solver.anti_aliasing and scenario.meta.scene != "muller"
+    if band_limit:
+        t_fine = np.arange((n_out - 1) * OVERSAMPLING + 1) / (OVERSAMPLING * rate)
+        t = t_fine[::OVERSAMPLING]
+    else:
+        t = np.arange(n_out) / rate
     signals: dict[str, np.ndarray] = {}
     if scenario.meta.scene == "muller":
+        qs, vs, acc = states(t)
         signals.update(_muller_signals(scenario, t, qs[0], vs[0], acc[0]))
+    elif not band_limit:
+        signals.update(_point_signals(scenario, built.dof_names, t, *states(t)))
     else:
-        signals.update(_torsional_signals(scenario, built.dof_names, t, qs, vs, acc))
-        if scenario.is_lateral:
-            signals.update(_lateral_signals(scenario, built.dof_names, qs, vs, acc, signals))
+        signals.update(_band_limited_signals(scenario, built.dof_names, t_fine, *states(t_fine)))
     stats = {
         "steps": n_steps,
         "method": scenario.solver.method,
@@ -255,6 +267,49 @@ def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
     return Result(time_s=t, signals=signals, meta=meta)
 
 
+def _point_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> dict[str, np.ndarray]:
+    signals = _torsional_signals(scenario, names, t, q, v, a, drive_torques=drive_torques)
+    if scenario.is_lateral:
+        signals.update(_lateral_signals(scenario, names, q, v, a, signals))
+    return signals
+
+
+def _band_limited_signals(scenario, names, t_fine, q, v, a) -> dict[str, np.ndarray]:
+    """Signals on the output grid ``t_fine[::OVERSAMPLING]``: states and instantaneous mesh forces as
+    exact samples; accelerations, bearing and housing signals, and a ``mesh_force_bandlimited_N``
+    companion through the anti-aliasing filter with the mesh-law jumps treated exactly."""
+    M = OVERSAMPLING
+    fine = _point_signals(scenario, names, t_fine, q, v, a, drive_torques=False)
+    t = t_fine[::M]
+    jumps = []
+    for k in range(len(scenario.stages)):
+        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        angle = fine[f"{gear_names(k)[0]}_angle_rad"]
+        delta = fine[prefix + "mesh_deflection_m"]
+        jumps.append(mesh_jump_times(t_fine, angle, delta, mesh_parameters_from_scenario(scenario, k)))
+    jumps = np.concatenate(jumps)
+    out = {}
+    for name, x in fine.items():
+        if is_band_limited(name):
+            out[name] = band_limited_samples(t_fine, x, M, jumps)
+        else:
+            out[name] = x[::M]
+        if name.endswith("mesh_force_N"):
+            out[name[: -len("_N")] + "_bandlimited_N"] = band_limited_samples(t_fine, x, M, jumps)
+    out.update(_drive_torques(scenario, t, out[f"{names[0]}_speed_rad_s"]))
+    return out
+
+
+def _drive_torques(scenario, t, motor_speed_rad_s) -> dict[str, np.ndarray]:
+    D = pack_drive_parameters(scenario)
+    return {
+        "motor_torque_Nm": np.array(
+            [motor_torque_at(tk, w, D) for tk, w in zip(t, motor_speed_rad_s, strict=True)]
+        ),
+        "load_torque_Nm": np.array([load_torque_at(tk, D) for tk in t]),
+    }
+
+
 def _mesh_signals(pinion_angle, delta, delta_rate, P, rated_force_N: float) -> dict[str, np.ndarray]:
     F, T = mesh_contact_series(
         np.ascontiguousarray(pinion_angle), np.ascontiguousarray(delta), np.ascontiguousarray(delta_rate), P
@@ -271,7 +326,7 @@ def _mesh_signals(pinion_angle, delta, delta_rate, P, rated_force_N: float) -> d
     }
 
 
-def _torsional_signals(scenario, names, t, q, v, a) -> dict[str, np.ndarray]:
+def _torsional_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> dict[str, np.ndarray]:
     out = {}
     for k, name in enumerate(names):
         if name.endswith(("_x", "_y")) and name[:-2] in names:
@@ -297,9 +352,8 @@ def _torsional_signals(scenario, names, t, q, v, a) -> dict[str, np.ndarray]:
         sig["mesh_frequency_hz"] = st.pinion.teeth * v[ip] / (2 * math.pi)
         prefix = "" if k == 0 else f"stage_{k + 1}_"
         out.update({prefix + key: value for key, value in sig.items()})
-    D = pack_drive_parameters(scenario)
-    out["motor_torque_Nm"] = np.array([motor_torque_at(tk, w, D) for tk, w in zip(t, v[0], strict=True)])
-    out["load_torque_Nm"] = np.array([load_torque_at(tk, D) for tk in t])
+    if drive_torques:
+        out.update(_drive_torques(scenario, t, v[0]))
     return out
 
 

@@ -263,6 +263,11 @@ class Solver:
     absolute_tolerance: float = param(1e-12, gt=0, doc="adaptive step absolute tolerance")
     max_step_s: float = param(1e-4, gt=0, doc="largest step")
     output_rate_hz: float = param(20000.0, gt=0, doc="results are sampled at k / output_rate_hz")
+    # The mesh force jumps when the pair count changes; point samples of it alias (its 1/k harmonics
+    # fold into the band of interest). docs/scenario.md, "Signals": which signals are band-limited.
+    anti_aliasing: bool = param(
+        True, doc="band-limit force and acceleration signals before sampling (measurement-chain filter)"
+    )
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -221,6 +221,29 @@ def mesh_phase_series(pinion_angle_rad: np.ndarray, P: np.ndarray):
     return p, i, j
 
 
+@njit(cache=True)
+def mesh_gap_series(pinion_angle_rad: np.ndarray, delta_m: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """d = delta + E(p) over arrays, m: contact starts or ends where d crosses +-l_u."""
+    z1 = int(P[I_Z1])
+    d = np.empty(pinion_angle_rad.size)
+    for m in range(pinion_angle_rad.size):
+        u = pinion_angle_rad[m] * z1 / (2.0 * math.pi)
+        n = math.floor(u)
+        d[m] = delta_m[m] + tooth_error_m(u - n, int(n % z1), P)
+    return d
+
+
+def mesh_breakpoint_phases(P: np.ndarray) -> np.ndarray:
+    """Mesh phases in [0, 1) where the force law jumps at fixed deflection: the tooth change (p = 0,
+    per-tooth stiffness factors), the single/double contact switches, the friction reversal."""
+    phases = [0.0]
+    if P[I_KIND] == PROFILE_CONTACT_RATIO and 0.0 < P[I_HALF_DOUBLE] < 0.5:
+        phases += [P[I_HALF_DOUBLE], 1.0 - P[I_HALF_DOUBLE]]
+    if P[I_MU] != 0.0:
+        phases.append(P[I_PITCH] % 1.0)
+    return np.unique(np.array(phases))
+
+
 def mean_stiffness_N_per_m(P: np.ndarray) -> float:
     """Exact mean of k_z(p) over one mesh period (healthy teeth), for linearised modes."""
     if P[I_KIND] == PROFILE_CONTACT_RATIO:

@@ -1,0 +1,45 @@
+"""Jump times of the mesh force law along a simulated run, for band-limited output sampling.
+
+The force law is continuous in the state except where the mesh phase passes a breakpoint of
+:func:`~gearbody.physics.mesh.mesh_breakpoint_phases` (tooth change, single/double contact switch,
+friction reversal) and where contact starts or ends (damping switches on with the deflection rate).
+Both are located on the fine output grid by linear interpolation of smooth functions of time
+(``u = z1 phi_p / 2 pi - p_break`` crossing an integer, ``d -+ l_u`` crossing zero).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..analysis.antialias import level_crossings
+from ..physics.mesh import I_LU, I_Z1, mesh_breakpoint_phases, mesh_gap_series
+
+OVERSAMPLING = 4
+"""Fine points per output sample on which band-limited signals are evaluated before filtering."""
+
+BAND_LIMITED_SUFFIXES = ("_accel_rad_s2", "_accel_m_s2", "_bearing_force_x_N", "_bearing_force_y_N")
+"""Signals replaced by their band-limited samples (accelerations, bearing and housing signals)."""
+
+
+def integer_crossings(t_s: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Times where the smooth sampled ``u`` crosses an integer (at most one per interval), s."""
+    n = np.floor(u)
+    j = np.flatnonzero(n[1:] != n[:-1])
+    level = np.maximum(n[j], n[j + 1])
+    return t_s[j] + (t_s[j + 1] - t_s[j]) * (level - u[j]) / (u[j + 1] - u[j])
+
+
+def mesh_jump_times(t_s: np.ndarray, pinion_angle_rad: np.ndarray, delta_m: np.ndarray, P: np.ndarray):
+    """All times in the run where this mesh's force law jumps, s (sorted)."""
+    u = pinion_angle_rad * P[I_Z1] / (2.0 * math.pi)
+    times = [integer_crossings(t_s, u - b) for b in mesh_breakpoint_phases(P)]
+    d = mesh_gap_series(np.ascontiguousarray(pinion_angle_rad), np.ascontiguousarray(delta_m), P)
+    lu = P[I_LU]
+    times += [level_crossings(t_s, d, lu), level_crossings(t_s, d, -lu)]
+    return np.sort(np.concatenate(times))
+
+
+def is_band_limited(name: str) -> bool:
+    return name.endswith(BAND_LIMITED_SUFFIXES) or "_housing_accel_" in name
