@@ -15,7 +15,7 @@ import numpy as np
 from ..model import Scenario
 from ..physics import mesh_parameters_from_scenario, pack_drive_parameters, steady_slip
 from ..physics.lateral import mesh_directions, static_bearing_displacement_m
-from ..physics.mesh import mesh_phase_series, stiffness_at_phase, tooth_error_m, tooth_pair_factor
+from ..physics.mesh import mesh_error_m, mesh_phase_series, stiffness_at_phase, tooth_pair_factor
 
 
 @dataclass(frozen=True)
@@ -227,7 +227,7 @@ def static_deflection_m(scenario: Scenario, stage: int, pinion_angle_rad: float,
             "start from rest"
         )
     st = scenario.stages[stage]
-    return force_N / k + st.mesh.backlash_um * 1e-6 - tooth_error_m(p, i, P)
+    return force_N / k + st.mesh.backlash_um * 1e-6 - mesh_error_m(pinion_angle_rad, P)
 
 
 def initial_state(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:

@@ -183,8 +183,19 @@ class ErrorMode:
 
 
 @dataclass(frozen=True, kw_only=True)
+class Eccentricity:
+    """Once-per-revolution error of one gear (eccentricity, run-out): A sin(phi + theta) along the line
+    of action, phi the gear's angle."""
+
+    gear: str = param(choices=("pinion", "wheel"))
+    amplitude_um: float = param(ge=0, le=1000, doc="amplitude A along the line of action")
+    phase_deg: float = param(0.0, ge=-360, le=360, doc="theta: phase at angle 0")
+
+
+@dataclass(frozen=True, kw_only=True)
 class Production:
     error_mode: ErrorMode = param(default_factory=ErrorMode)
+    eccentricity: tuple[Eccentricity, ...] = param((), doc="once-per-revolution errors, one per gear at most")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -228,9 +239,22 @@ class DamagedTooth:
 
 
 @dataclass(frozen=True, kw_only=True)
+class PittedTooth:
+    """A pit (spall) on one tooth's flank: the pair deflects depth_um less while that tooth is in mesh
+    between two mesh phases (material missing)."""
+
+    gear: str = param(choices=("pinion", "wheel"))
+    tooth: int = param(ge=0, doc="tooth index, 0-based")
+    depth_um: float = param(ge=0, le=1000, doc="depth of the missing material along the line of action")
+    start_phase: float = param(ge=0, lt=1, doc="mesh phase where the pit starts")
+    end_phase: float = param(gt=0, le=1, doc="mesh phase where the pit ends (> start_phase)")
+
+
+@dataclass(frozen=True, kw_only=True)
 class Condition:
     friction_coefficient: float = param(0.0, ge=0, lt=1, doc="inter-tooth friction mu")
     damaged_teeth: tuple[DamagedTooth, ...] = param((), doc="per-tooth stiffness factors")
+    pitted_teeth: tuple[PittedTooth, ...] = param((), doc="local pitting errors (one per tooth)")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -242,6 +266,8 @@ class Stage:
     mesh: Mesh = param(default_factory=Mesh)
     error_mode: ErrorMode = param(default_factory=ErrorMode)
     damaged_teeth: tuple[DamagedTooth, ...] = param((), doc="per-tooth stiffness factors of this stage")
+    eccentricity: tuple[Eccentricity, ...] = param((), doc="once-per-revolution errors of this stage")
+    pitted_teeth: tuple[PittedTooth, ...] = param((), doc="local pitting errors of this stage")
 
     @property
     def ratio(self) -> float:
@@ -322,13 +348,30 @@ class Scenario:
                     f"meshing gears need equal base pitches (r_b2 = r_b1 z2 / z1 = "
                     f"{stage.pinion.base_radius_m * stage.wheel.teeth / stage.pinion.teeth:.6g} m)"
                 )
-            for t in stage.damaged_teeth:
-                z = getattr(stage, t.gear).teeth
-                if t.tooth >= z:
-                    where_t = f"design.stages[{k}]." if self.meta.scene == "train" else "condition."
+            train = self.meta.scene == "train"
+            per_tooth = (("damaged_teeth", stage.damaged_teeth), ("pitted_teeth", stage.pitted_teeth))
+            for key, entries in per_tooth:
+                where_t = f"design.stages[{k}]." if train else "condition."
+                for t in entries:
+                    z = getattr(stage, t.gear).teeth
+                    if t.tooth >= z:
+                        raise ScenarioError(
+                            f"{where_t}{key}: tooth = {t.tooth} on the {t.gear}: must be < its {z} teeth"
+                        )
+                teeth = [(t.gear, t.tooth) for t in entries]
+                if key == "pitted_teeth" and len(set(teeth)) < len(teeth):
+                    raise ScenarioError(f"{where_t}pitted_teeth: one pit per tooth, got {teeth}")
+            where_p = f"design.stages[{k}]." if train else "condition."
+            for t in stage.pitted_teeth:
+                if not t.end_phase > t.start_phase:
                     raise ScenarioError(
-                        f"{where_t}damaged_teeth: tooth = {t.tooth} on the {t.gear}: must be < its {z} teeth"
+                        f"{where_p}pitted_teeth: end_phase = {t.end_phase} must be > start_phase = "
+                        f"{t.start_phase} (a pit spans [start_phase, end_phase) of the mesh period)"
                     )
+            gears = [e.gear for e in stage.eccentricity]
+            if len(set(gears)) < len(gears):
+                where_e = f"design.stages[{k}]." if train else "production."
+                raise ScenarioError(f"{where_e}eccentricity: at most one entry per gear, got {gears}")
         if self.meta.scene in ("muller", "two-wheel"):
             for name in ("pinion", "wheel"):
                 if getattr(d, name).lateral != "none":
@@ -357,6 +400,8 @@ class Scenario:
                 mesh=d.mesh,
                 error_mode=self.production.error_mode,
                 damaged_teeth=self.condition.damaged_teeth,
+                eccentricity=self.production.eccentricity,
+                pitted_teeth=self.condition.pitted_teeth,
             ),
         )
 

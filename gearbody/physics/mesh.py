@@ -9,6 +9,10 @@ Conventions (docs/scenario.md): mesh phase ``p = frac(phi_p z1 / 2 pi)`` from th
 pinion tooth ``i = n mod z1`` and wheel tooth ``j = n mod z2`` with ``n = floor(phi_p z1 / 2 pi)``;
 ``d = delta + E(p)``, ``F_el = k (max(d - l_u, min(d + l_u, 0)))``; damping only in contact;
 friction ``T = mu |F| s(p)`` reversing at the pitch point, arms ``rho_1, rho_2`` along the line of action.
+The error ``E`` is the tooth error mode plus two production/condition faults: a once-per-revolution
+run-out of either gear, ``A sin(phi + theta)`` along the line of action (wheel angle taken as
+``phi_p z1 / z2``), and a pit on a tooth flank, ``-depth`` while that tooth's pair is between two mesh
+phases (material missing: the pair deflects less).
 """
 
 from __future__ import annotations
@@ -26,7 +30,10 @@ I_KIND, I_KSINGLE, I_KDOUBLE, I_HALF_DOUBLE = 4, 5, 6, 7
 I_CZ, I_LU, I_MU, I_PITCH = 8, 9, 10, 11
 I_ARM1, I_ARM2, I_PB, I_A = 12, 13, 14, 15
 I_NTAB = 16
-I_HEADER = 20  # e_i (z1), pinion factors (z1), wheel factors (z2), table phases (n), table k (n)
+I_ECC_P, I_ECC_P_PHASE, I_ECC_W, I_ECC_W_PHASE = 17, 18, 19, 20  # run-out amplitudes (m), phases (rad)
+I_HEADER = 24
+# after the header: e_i (z1), pinion factors (z1), wheel factors (z2), table phases (n), table k (n),
+# pit depth / start phase / end phase per pinion tooth (3 z1), then per wheel tooth (3 z2)
 
 PROFILE_CONTACT_RATIO, PROFILE_TABLE = 0.0, 1.0
 
@@ -51,6 +58,10 @@ def pack_mesh_parameters(
     wheel_factors: np.ndarray | None = None,
     table_phase: np.ndarray | None = None,
     table_stiffness_N_per_m: np.ndarray | None = None,
+    runout_m: tuple[float, float] = (0.0, 0.0),
+    runout_phase_rad: tuple[float, float] = (0.0, 0.0),
+    pinion_pits: np.ndarray | None = None,
+    wheel_pits: np.ndarray | None = None,
 ) -> np.ndarray:
     """Pack everything the mesh law needs into one float64 array (see module docstring)."""
     f = np.ones(z1) if pinion_factors is None else np.asarray(pinion_factors, float)
@@ -58,6 +69,10 @@ def pack_mesh_parameters(
     tp = np.zeros(0) if table_phase is None else np.asarray(table_phase, float)
     tk = np.zeros(0) if table_stiffness_N_per_m is None else np.asarray(table_stiffness_N_per_m, float)
     e = np.asarray(error_depths_m, float)
+    pits_p = np.zeros((z1, 3)) if pinion_pits is None else np.asarray(pinion_pits, float)
+    pits_w = np.zeros((z2, 3)) if wheel_pits is None else np.asarray(wheel_pits, float)
+    if pits_p.shape != (z1, 3) or pits_w.shape != (z2, 3):
+        raise ValueError("pit arrays must have one (depth_m, start_phase, end_phase) row per tooth")
     if e.shape != (z1,) or f.shape != (z1,) or g.shape != (z2,) or tp.shape != tk.shape:
         raise ValueError(
             "per-tooth arrays must have z1 (errors, pinion factors) or z2 (wheel factors) values"
@@ -78,7 +93,9 @@ def pack_mesh_parameters(
     head[I_PB] = 2.0 * math.pi * r1_m / z1
     head[I_A] = error_a
     head[I_NTAB] = tp.size
-    return np.concatenate([head, e, f, g, tp, tk])
+    head[I_ECC_P], head[I_ECC_W] = runout_m
+    head[I_ECC_P_PHASE], head[I_ECC_W_PHASE] = runout_phase_rad
+    return np.concatenate([head, e, f, g, tp, tk, pits_p.T.ravel(), pits_w.T.ravel()])
 
 
 def mesh_parameters_from_scenario(scenario, stage: int = 0, *, friction: bool = True) -> np.ndarray:
@@ -90,6 +107,13 @@ def mesh_parameters_from_scenario(scenario, stage: int = 0, *, friction: bool = 
     for tooth in st.damaged_teeth:
         (f if tooth.gear == "pinion" else g)[tooth.tooth] *= tooth.stiffness_factor
     table = mesh.stiffness_profile == "table"
+    runout, runout_phase = [0.0, 0.0], [0.0, 0.0]
+    for ecc in st.eccentricity:
+        k = 0 if ecc.gear == "pinion" else 1
+        runout[k], runout_phase[k] = ecc.amplitude_um * 1e-6, math.radians(ecc.phase_deg)
+    pits = {"pinion": np.zeros((z1, 3)), "wheel": np.zeros((z2, 3))}
+    for pit in st.pitted_teeth:
+        pits[pit.gear][pit.tooth] = (pit.depth_um * 1e-6, pit.start_phase, pit.end_phase)
     return pack_mesh_parameters(
         r1_m=st.pinion.base_radius_m,
         r2_m=st.wheel.base_radius_m,
@@ -109,6 +133,10 @@ def mesh_parameters_from_scenario(scenario, stage: int = 0, *, friction: bool = 
         wheel_factors=g,
         table_phase=np.array(mesh.table_phase) if table else None,
         table_stiffness_N_per_m=np.array(mesh.table_stiffness_N_per_m) if table else None,
+        runout_m=(runout[0], runout[1]),
+        runout_phase_rad=(runout_phase[0], runout_phase[1]),
+        pinion_pits=pits["pinion"],
+        wheel_pits=pits["wheel"],
     )
 
 
@@ -154,6 +182,34 @@ def tooth_error_m(p: float, i: int, P: np.ndarray) -> float:
 
 
 @njit(cache=True)
+def _pit_m(p: float, tooth: int, offset: int, teeth: int, P: np.ndarray) -> float:
+    depth = P[offset + tooth]
+    if depth == 0.0:
+        return 0.0
+    if P[offset + teeth + tooth] <= p < P[offset + 2 * teeth + tooth]:
+        return depth
+    return 0.0
+
+
+@njit(cache=True)
+def mesh_error_m(pinion_angle_rad: float, P: np.ndarray) -> float:
+    """Total error E at a pinion angle, m: tooth error mode + run-out of both gears - pits."""
+    z1, z2 = int(P[I_Z1]), int(P[I_Z2])
+    u = pinion_angle_rad * z1 / (2.0 * math.pi)
+    n = math.floor(u)
+    p = u - n
+    i = int(n % z1)
+    j = int(n % z2)
+    E = tooth_error_m(p, i, P)
+    if P[I_ECC_P] != 0.0:
+        E += P[I_ECC_P] * math.sin(pinion_angle_rad + P[I_ECC_P_PHASE])
+    if P[I_ECC_W] != 0.0:
+        E += P[I_ECC_W] * math.sin(pinion_angle_rad * z1 / z2 + P[I_ECC_W_PHASE])
+    o = I_HEADER + 2 * z1 + z2 + 2 * int(P[I_NTAB])
+    return E - _pit_m(p, i, o, z1, P) - _pit_m(p, j, o + 3 * z1, z2, P)
+
+
+@njit(cache=True)
 def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float, P: np.ndarray):
     """Normal mesh force F (N, elastic + damping), friction force T (N) and arms rho_1, rho_2 (m).
 
@@ -168,7 +224,7 @@ def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float,
     j = int(n % z2)
     factor = tooth_pair_factor(i, j, P)
     k = stiffness_at_phase(p, P) * factor
-    d = delta_m + tooth_error_m(p, i, P)
+    d = delta_m + mesh_error_m(pinion_angle_rad, P)
     lu = P[I_LU]
     if d > lu:
         F = k * (d - lu) + P[I_CZ] * factor * delta_rate_m_s
@@ -224,23 +280,26 @@ def mesh_phase_series(pinion_angle_rad: np.ndarray, P: np.ndarray):
 @njit(cache=True)
 def mesh_gap_series(pinion_angle_rad: np.ndarray, delta_m: np.ndarray, P: np.ndarray) -> np.ndarray:
     """d = delta + E(p) over arrays, m: contact starts or ends where d crosses +-l_u."""
-    z1 = int(P[I_Z1])
     d = np.empty(pinion_angle_rad.size)
     for m in range(pinion_angle_rad.size):
-        u = pinion_angle_rad[m] * z1 / (2.0 * math.pi)
-        n = math.floor(u)
-        d[m] = delta_m[m] + tooth_error_m(u - n, int(n % z1), P)
+        d[m] = delta_m[m] + mesh_error_m(pinion_angle_rad[m], P)
     return d
 
 
 def mesh_breakpoint_phases(P: np.ndarray) -> np.ndarray:
     """Mesh phases in [0, 1) where the force law jumps at fixed deflection: the tooth change (p = 0,
-    per-tooth stiffness factors), the single/double contact switches, the friction reversal."""
+    per-tooth stiffness factors), the single/double contact switches, the friction reversal, pit edges."""
     phases = [0.0]
     if P[I_KIND] == PROFILE_CONTACT_RATIO and 0.0 < P[I_HALF_DOUBLE] < 0.5:
         phases += [P[I_HALF_DOUBLE], 1.0 - P[I_HALF_DOUBLE]]
     if P[I_MU] != 0.0:
         phases.append(P[I_PITCH] % 1.0)
+    z1, z2 = int(P[I_Z1]), int(P[I_Z2])
+    o = I_HEADER + 2 * z1 + z2 + 2 * int(P[I_NTAB])
+    for offset, teeth in ((o, z1), (o + 3 * z1, z2)):
+        pitted = P[offset : offset + teeth] != 0.0
+        phases += list(P[offset + teeth : offset + 2 * teeth][pitted])
+        phases += list(P[offset + 2 * teeth : offset + 3 * teeth][pitted] % 1.0)
     return np.unique(np.array(phases))
 
 
