@@ -10,6 +10,22 @@ from gearbody.analysis.dynamic_factor import (
     separation_stats,
     unstable,
 )
+from gearbody.analysis.indicators import (
+    ConditionIndicators,
+    condition_indicators,
+    condition_indicators_from_average,
+    crest_factor,
+    energy_ratio,
+    fm0,
+    fm4,
+    kurtosis,
+    m6a,
+    m8a,
+    na4,
+    peak_to_peak,
+    rms,
+    sideband_energy_ratio,
+)
 from gearbody.analysis.spectrum import (
     Peak,
     SidebandLine,
@@ -20,8 +36,27 @@ from gearbody.analysis.spectrum import (
     peak_near,
     sideband_lines,
 )
+from gearbody.analysis.tsa import AngleDomainSignal, SynchronousAverage, angle_resample, synchronous_average
 
 __all__ = [
+    "AngleDomainSignal",
+    "ConditionIndicators",
+    "SynchronousAverage",
+    "angle_resample",
+    "condition_indicators",
+    "condition_indicators_from_average",
+    "crest_factor",
+    "energy_ratio",
+    "fm0",
+    "fm4",
+    "kurtosis",
+    "m6a",
+    "m8a",
+    "na4",
+    "peak_to_peak",
+    "rms",
+    "sideband_energy_ratio",
+    "synchronous_average",
     "INSTABILITY_KD",
     "FoldedSignal",
     "Peak",
