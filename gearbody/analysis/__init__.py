@@ -26,6 +26,18 @@ from gearbody.analysis.indicators import (
     rms,
     sideband_energy_ratio,
 )
+from gearbody.analysis.labels import (
+    GearMesh,
+    KinematicSources,
+    LabelledPeak,
+    Psd,
+    Shaft,
+    kinematic_lines,
+    label_peaks,
+    peaks_table,
+    peaks_to_rows,
+    power_spectral_density,
+)
 from gearbody.analysis.spectrum import (
     Peak,
     SidebandLine,
@@ -39,6 +51,16 @@ from gearbody.analysis.spectrum import (
 from gearbody.analysis.tsa import AngleDomainSignal, SynchronousAverage, angle_resample, synchronous_average
 
 __all__ = [
+    "GearMesh",
+    "KinematicSources",
+    "LabelledPeak",
+    "Psd",
+    "Shaft",
+    "kinematic_lines",
+    "label_peaks",
+    "peaks_table",
+    "peaks_to_rows",
+    "power_spectral_density",
     "AngleDomainSignal",
     "ConditionIndicators",
     "SynchronousAverage",
