@@ -56,6 +56,11 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time (sets operation.t_end_s)")
     run.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: runs/SCENE)")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run.add_argument(
+        "--report",
+        action="store_true",
+        help="also write DIR/report.html: summary, labelled spectrum, folded K_d, TSA and indicators",
+    )
     run.add_argument("--quiet", action="store_true", help="no progress display and no summary on screen")
 
     modes = sub.add_parser(
@@ -115,6 +120,10 @@ def cmd_run(args) -> int:
     summary["wall_time_s"] = time.perf_counter() - t0
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     plots = [] if args.no_plots else write_plots(result, out)
+    if args.report:
+        from .report import write_report
+
+        write_report(result, out / "report.html")
     if not args.quiet:
         print(f"{scenario.meta.title}")
         for key in (
@@ -132,6 +141,7 @@ def cmd_run(args) -> int:
         print(
             f"wrote {out}/result.npz, scenario.toml, summary.json"
             + (f", {len(plots)} plots" if plots else "")
+            + (", report.html" if args.report else "")
         )
     return 0
 

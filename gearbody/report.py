@@ -1,0 +1,169 @@
+"""One self-contained HTML page per run: summary, labelled spectrum, folded K_d, TSA and indicators.
+
+Engine-free: works on any :class:`~gearbody.result.Result` (simulated, or loaded from result.npz).
+Figures are embedded as base64 PNG, so the page can be mailed or archived on its own.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .analysis import (
+    KinematicSources,
+    amplitude_spectrum,
+    condition_indicators_from_average,
+    fold_over_mesh_period,
+    kinematic_lines,
+    label_peaks,
+    peaks_to_rows,
+    synchronous_average,
+)
+from .analysis.labels import plot_labelled_spectrum
+from .plots import _figure
+from .result import Result
+from .summary import FINAL_FRACTION, final_window, summarize, vibration_signal
+
+__all__ = ["report_sections", "write_report"]
+
+MIN_TSA_REVOLUTIONS = 2
+
+
+def _png(fig) -> str:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _table(rows: list[dict[str, Any]], columns: list[str] | None = None) -> str:
+    if not rows:
+        return "<p><em>none</em></p>"
+    columns = columns or list(rows[0])
+
+    def cell(v):
+        if v is None:
+            return ""
+        if isinstance(v, float):
+            return f"{v:.4g}"
+        if isinstance(v, (list, tuple)):
+            return html.escape("; ".join(map(str, v)))
+        return html.escape(str(v))
+
+    head = "".join(f"<th>{html.escape(c)}</th>" for c in columns)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{cell(r.get(c, ''))}</td>" for c in columns) + "</tr>" for r in rows
+    )
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def report_sections(result: Result) -> dict[str, Any]:
+    """The report's content as data: summary, labelled peaks, indicators, and figures (base64 PNG)."""
+    win = final_window(result)
+    summary = summarize(result)
+    name, signal = vibration_signal(result)
+    z1 = int(result.meta["pinion_teeth"])
+    stages = result.meta.get("stages") or [{"pinion_teeth": z1, "wheel_teeth": result.meta["wheel_teeth"]}]
+    teeth = [(int(s["pinion_teeth"]), int(s["wheel_teeth"])) for s in stages]
+    f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
+    out: dict[str, Any] = {"summary": summary, "signal": name, "figures": {}}
+
+    # labelled spectrum of the vibration signal over the final window
+    spec = amplitude_spectrum(signal[win], result.sample_rate_hz, window="hann")
+    unit = "rad/s^2" if name.endswith("rad_s2") else "m/s^2"
+    peaks = []
+    if f_mesh > 0:
+        f_max = min(result.sample_rate_hz / 2, 6 * f_mesh)
+        sources = KinematicSources.gear_train(f_mesh / z1, teeth)
+        lines = kinematic_lines(sources, f_max, harmonics=6, sidebands=3, shaft_orders=30)
+        tolerance = max(1.5 * spec.resolution_hz, 0.0)
+        peaks = label_peaks(spec, lines, tolerance_hz=tolerance, min_prominence_db=12.0, max_peaks=40,
+                            f_max_hz=f_max)
+        fig = _figure((1100, 500), 100)
+        plot_labelled_spectrum(spec, peaks, ax=fig.add_subplot(1, 1, 1), title=f"spectrum of {name}",
+                               unit=unit, f_max_hz=f_max)
+        out["figures"]["spectrum"] = _png(fig)
+    out["peaks"] = peaks_to_rows(peaks)
+
+    # K_d folded over the mesh period
+    if f_mesh > 0:
+        bins = int(np.clip(result.sample_rate_hz / f_mesh, 10, 100))
+        folded = fold_over_mesh_period(result.kd[win], result["pinion_angle_rad"][win], z1, bins=bins)
+        fig = _figure((900, 400), 100)
+        ax = fig.add_subplot(1, 1, 1)
+        ax.fill_between(folded.percent_of_period, folded.minimum, folded.maximum, alpha=0.3, label="min-max")
+        ax.plot(folded.percent_of_period, folded.mean, label="mean")
+        ax.axhline(2.0, color="red", ls=":", lw=0.8)
+        ax.set_xlabel("mesh period [%]")
+        ax.set_ylabel("K_d")
+        ax.legend()
+        ax.set_title(f"K_d over the mesh period (last {FINAL_FRACTION:.0%} of the run)")
+        out["figures"]["kd_folded"] = _png(fig)
+
+    # synchronous average over pinion revolutions, and condition indicators
+    angle = result["pinion_angle_rad"][win]
+    revs = (angle[-1] - angle[0]) / (2 * np.pi)
+    out["indicators"] = {}
+    if revs >= MIN_TSA_REVOLUTIONS + 1 and np.all(np.diff(angle) > 0):
+        tsa = synchronous_average(signal[win], angle, teeth=z1)
+        out["indicators"] = condition_indicators_from_average(tsa).as_dict()
+        out["tsa_revolutions"] = tsa.n_revs
+        fig = _figure((1100, 500), 100)
+        ax = fig.add_subplot(2, 1, 1)
+        deg = np.degrees(tsa.angle_rad)
+        ax.plot(deg, tsa.average, lw=0.7)
+        ax.set_title(f"TSA of {name} over {tsa.n_revs} pinion revolutions", fontsize=9)
+        ax = fig.add_subplot(2, 1, 2)
+        ax.plot(deg, tsa.difference(), lw=0.7, color="C3")
+        ax.set_title(
+            "difference signal (mesh harmonics, first sidebands, shaft orders 1-2 removed)", fontsize=9
+        )
+        ax.set_xlabel("pinion angle [deg]")
+        out["figures"]["tsa"] = _png(fig)
+    else:
+        out["tsa_note"] = (
+            f"no TSA: the final window holds {revs:.1f} pinion revolutions "
+            f"(needs {MIN_TSA_REVOLUTIONS + 1}, monotone angle)"
+        )
+    return out
+
+
+def write_report(result: Result, path: str | Path) -> Path:
+    """Write the report page for ``result`` to ``path`` (.html)."""
+    s = report_sections(result)
+    title = html.escape(str(result.meta.get("title", result.meta.get("scene", "gearbody run"))))
+    summary_rows = [{"quantity": k, "value": v} for k, v in s["summary"].items() if not isinstance(v, dict)]
+    fig = s["figures"]
+    img = {k: f'<img src="data:image/png;base64,{v}" alt="{k}">' for k, v in fig.items()}
+    parts = [
+        "<!DOCTYPE html><html><head><meta charset='utf-8'>",
+        f"<title>{title}</title>",
+        "<style>body{font-family:sans-serif;max-width:1150px;margin:auto;padding:1em}"
+        "table{border-collapse:collapse;font-size:13px}td,th{border:1px solid #ccc;padding:2px 6px;"
+        "text-align:right}th{background:#eee}img{max-width:100%}</style></head><body>",
+        f"<h1>{title}</h1>",
+        f"<p>scene <code>{html.escape(str(result.meta.get('scene', '')))}</code>, gearbody "
+        f"{html.escape(str(result.meta.get('gearbody_version', '')))}; analysed window: the last "
+        f"{FINAL_FRACTION:.0%} of the run; vibration signal <code>{html.escape(s['signal'])}</code>.</p>",
+        "<h2>Summary</h2>",
+        _table(summary_rows),
+        "<h2>K_d over the mesh period</h2>",
+        img.get("kd_folded", "<p>no mesh frequency</p>"),
+        "<h2>Labelled spectrum</h2>",
+        img.get("spectrum", ""),
+        _table(s["peaks"]),
+        "<h2>Synchronous average and condition indicators</h2>",
+        img.get("tsa", f"<p>{html.escape(s.get('tsa_note', ''))}</p>"),
+        _table([{"indicator": k, "value": v} for k, v in s["indicators"].items()]),
+        "</body></html>",
+    ]
+    path = Path(path)
+    path.write_text("\n".join(parts))
+    return path

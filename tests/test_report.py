@@ -1,0 +1,66 @@
+"""The HTML report and the resonance tools (issue 4, items 3 and 5)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from gearbody.engine import scene_modes, simulate
+from gearbody.model import load_scenario
+from gearbody.report import report_sections, write_report
+from gearbody.resonance import (
+    campbell_lines,
+    kd_speed_sweep,
+    plot_campbell,
+    plot_kd_against_speed,
+    steady_overrides,
+)
+
+
+@pytest.fixture(scope="module")
+def steady_run():
+    sc = load_scenario(
+        "two-wheel", [*steady_overrides(1.0, 1.2), "production.error_mode={a=0.5,e_um=10.0,r=0.3}"]
+    )
+    return simulate(sc)
+
+
+def test_report_is_one_self_contained_page(steady_run, tmp_path):
+    path = write_report(steady_run, tmp_path / "report.html")
+    text = path.read_text()
+    for heading in ("Summary", "K_d over the mesh period", "Labelled spectrum", "Synchronous average"):
+        assert f"<h2>{heading}" in text
+    assert text.count("data:image/png;base64,") == 3  # folded K_d, spectrum, TSA embedded
+    assert 'src="http' not in text and "href=" not in text  # nothing external
+
+
+def test_report_labels_the_mesh_line_and_computes_indicators(steady_run):
+    s = report_sections(steady_run)
+    mesh = [p for p in s["peaks"] if "1 f_z1" in p["label"]]
+    assert mesh, s["peaks"][:5]
+    f_z = float(np.mean(steady_run["mesh_frequency_hz"]))
+    assert abs(mesh[0]["frequency_hz"] - f_z) <= 2 * (1 / 0.3)  # within the final window's resolution
+    assert s["tsa_revolutions"] >= 3
+    assert s["indicators"]["kurtosis"] > 1.0 and s["indicators"]["rms"] > 0
+
+
+def test_campbell_crossings_by_hand():
+    lines = campbell_lines([100.0, 2900.0], pinion_teeth=29, harmonics=2)
+    # k z1 w / 2 pi = f  ->  w = 2 pi f / (k z1)
+    np.testing.assert_allclose(lines["speed_rad_s"][0], [2 * math.pi * 100 / 29, 2 * math.pi * 100])
+    np.testing.assert_allclose(lines["speed_rad_s"][1], [math.pi * 100 / 29, math.pi * 100])
+
+
+def test_kd_peaks_at_the_mesh_mode(tmp_path):
+    """two-wheel: the mesh mode (429 Hz) is met at 0.87 of the synchronous speed; K_d there exceeds
+    K_d well below and above it (the paper's Figs. 5-8)."""
+    sc = load_scenario("two-wheel", ["production.error_mode={a=0.5,e_um=10.0,r=0.0}"])
+    sweep = kd_speed_sweep(sc, [0.6, 0.87, 1.3], settle_s=0.04, record_s=0.03)
+    assert not any(sweep.errors)
+    assert sweep.kd_max[1] > max(sweep.kd_max[0], sweep.kd_max[2])
+    assert sweep.mesh_frequency_hz[1] == pytest.approx(429, rel=0.03)
+    modes = scene_modes(sc).frequencies_hz
+    assert plot_kd_against_speed(sweep, modes, tmp_path / "kd.png").stat().st_size > 1000
+    assert plot_campbell(modes, 29, 200, tmp_path / "c.png", operating_speed_rad_s=107).stat().st_size > 1000
+    with pytest.raises(ValueError, match="speed_fractions"):
+        kd_speed_sweep(sc, [0.0])
