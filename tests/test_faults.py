@@ -73,3 +73,23 @@ def test_a_pit_lowers_the_force_by_k_times_depth():
 def test_bad_fault_input_is_refused_by_name(override, needle):
     with pytest.raises(ScenarioError, match=needle):
         load_scenario("one-stage", [override])
+
+
+def test_a_missing_tooth_next_to_a_loaded_one_is_reported_not_hung():
+    """Stiffness factor 0 on one tooth: the lumped mesh chatters across that tooth's edge and Exudyn's
+    step control rejects steps forever; the watchdog in the motor user function reports it."""
+    from gearbody.engine import SimulationError, simulate
+
+    sc = load_scenario(
+        "one-stage",
+        [
+            'operation.initial_state="steady"',
+            "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
+            "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
+            "operation.t_end_s=0.03",
+            'condition.damaged_teeth=[{gear="pinion",tooth=5,stiffness_factor=0.0}]',
+            *QUIET,
+        ],
+    )
+    with pytest.raises(SimulationError, match=r"stalled at t = 0\.01"):
+        simulate(sc)

@@ -348,8 +348,32 @@ def _bearing_user_function(law, free_directions: tuple[int, ...]):
     return bearing_force
 
 
+class StallError(RuntimeError):
+    """Raised from inside a user function when the solver makes no progress in time."""
+
+
+STALL_CALLS = 200_000  # right-hand-side evaluations per check (~30k steps: ~0.1 s simulated normally)
+STALL_ADVANCE_S = 1e-9
+
+
 def _motor_user_function(D: np.ndarray):
+    """Motor torque; also the stall watchdog: Exudyn's step control can reject steps at the minimum step
+    size forever (no pre-step call happens then), but every attempt evaluates this function."""
+    state = {"calls": 0, "t_check": -1.0, "t_max": -1.0}
+
     def motor_torque(mbs, t, itemNumber, q, q_t):
+        state["calls"] += 1
+        if t > state["t_max"]:
+            state["t_max"] = t
+        if state["calls"] % STALL_CALLS == 0:
+            if state["t_max"] - state["t_check"] < STALL_ADVANCE_S:
+                raise StallError(
+                    f"the solver stalled at t = {state['t_max']:.9g} s: {STALL_CALLS} force evaluations "
+                    f"advanced less than {STALL_ADVANCE_S:g} s (step size collapse at a discontinuity, "
+                    "e.g. a tooth with stiffness factor 0 next to a loaded one). Hint: use a small "
+                    "non-zero stiffness factor, or loosen solver.relative_tolerance / absolute_tolerance"
+                )
+            state["t_check"] = state["t_max"]
         return [motor_torque_at(t, q_t[0], D)]
 
     return motor_torque

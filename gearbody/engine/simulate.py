@@ -172,6 +172,12 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
         exu.SolveDynamic(
             mbs, settings, solverType=SOLVER_TYPES[scenario.solver.method], storeSolver=True, showHints=False
         )
+    except Exception as exc:  # a user function raised (stall watchdog) or Exudyn failed
+        message = str(exc)
+        if "stalled" in message:
+            raise SimulationError(message[message.index("the solver stalled") :].split("\n")[0]) from None
+        last = message.strip().splitlines()[-1] if message.strip() else repr(exc)
+        raise SimulationError(f"Exudyn stopped: {last}") from exc
     finally:
         exu.config.suppressWarnings = False
         monitor.close()

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from gearbody.analysis import amplitude_spectrum
+from gearbody.engine import SimulationError
 from gearbody.plots import _figure, _save
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
@@ -45,11 +46,16 @@ def shaft_order_share(spectrum, f_shaft: float, f_z: float, f_max: float, top: i
 
 
 def main() -> None:
-    spectra, wideband, share, lines = {}, {}, {}, {}
+    spectra, wideband, share, lines, failed = {}, {}, {}, {}, {}
     with Timer() as timer:
         for factor in FACTORS:
-            res, window = tooth_run(factor, RECORD_S)
             label = "healthy" if factor is None else f"{factor:.1f} k_z"
+            try:
+                res, window = tooth_run(factor, RECORD_S)
+            except SimulationError as exc:
+                failed[label] = str(exc)
+                print(label, "failed:", exc)
+                continue
             sp = amplitude_spectrum(res[SIGNAL][window], res.sample_rate_hz, window="hann")
             f_z = float(np.mean(res["mesh_frequency_hz"][window]))
             f_p = float(np.mean(res["pinion_speed_rad_s"][window])) / (2 * np.pi)
@@ -72,9 +78,9 @@ def main() -> None:
     figs = [_save(fig, RESULTS_DIR / "figs_13_16_spectra.png", 100)]
     damaged = [k for k in wideband if k != "healthy"]
     values = [wideband[k] for k in damaged]
-    f_z, f_p = lines["0.0 k_z"]
+    f_z, f_p = lines[damaged[-1]]
     claims = [
-        Claim("13-16", "wideband content grows with the tooth fracture 0.8 -> 0.6 -> 0.2 -> 0.0 k_z",
+        Claim("13-16", "wideband content grows with the tooth fracture " + " -> ".join(damaged),
               " / ".join(f"{v:.3g}" for v in values) + f" rad/s^2 (healthy {wideband['healthy']:.3g})",
               all(b > a for a, b in zip(values, values[1:], strict=False))
               and values[0] > wideband["healthy"]),
@@ -83,6 +89,9 @@ def main() -> None:
               + " / ".join(f"{share[k]:.2f}" for k in damaged) + f" (f_pinion {f_p:.2f} Hz)",
               min(share[k] for k in damaged) >= 0.9),
     ]
+    for label, message in failed.items():
+        claims.append(Claim("13-16", f"the {label} case runs", "simulation failed: " + message, False,
+                            "lumped mesh model: the pinion chatters across the edge of the missing tooth"))
     notes = [
         f"Signal {SIGNAL}, {RECORD_S} s after 0.1 s settling, Hann window "
         f"({spectra['healthy'].resolution_hz:.2f} Hz bins), band 5 Hz - 4.5 f_z; mesh harmonics "
