@@ -93,3 +93,19 @@ def test_a_missing_tooth_next_to_a_loaded_one_is_reported_not_hung():
     )
     with pytest.raises(SimulationError, match=r"stalled at t = 0\.01"):
         simulate(sc)
+
+
+def test_numba_cache_is_dropped_when_any_physics_source_changes(tmp_path):
+    """numba re-checks only a function's own file; a kernel calling into a changed module would keep the
+    old callee. gearbody drops the package's cache files whenever any source differs."""
+    from gearbody.physics._numba_cache import refresh
+
+    (tmp_path / "a.py").write_text("x = 1\n")
+    cache = tmp_path / "__pycache__"
+    cache.mkdir()
+    (cache / "a.f-1.py311.nbi").write_bytes(b"old")
+    assert refresh(tmp_path) and not list(cache.glob("*.nbi"))  # first sight: unknown sources
+    (cache / "a.f-1.py311.nbi").write_bytes(b"compiled")
+    assert not refresh(tmp_path) and list(cache.glob("*.nbi"))  # unchanged: kept
+    (tmp_path / "b.py").write_text("y = 2\n")  # another module changes
+    assert refresh(tmp_path) and not list(cache.glob("*.nbi"))

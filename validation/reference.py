@@ -13,9 +13,10 @@ segment in *locked modes*:
 
 * phase mode ``(n, k)``: the pinion mesh coordinate ``u = phi_p z1 / (2 pi)`` lies in
   ``[n + b_k, n + b_{k+1})`` where ``b`` are all phase break points in one mesh period (0, h, 1-h,
-  pitch_point_phase, error apex ``a``, table points).  Inside such an interval every mesh quantity
-  is a polynomial (at most linear) function of ``p = u - n`` and is evaluated from that formula,
-  so the right-hand side is smooth, also a little beyond the interval ends during trial steps;
+  pitch_point_phase, error apex ``a``, table points, pit edges).  Inside such an interval every mesh
+  quantity is a polynomial (at most linear) function of ``p = u - n``, plus the smooth run-out term,
+  and is evaluated from that formula, so the right-hand side is smooth, also a little beyond the
+  interval ends during trial steps;
 * contact mode ``c`` in {+1 flank contact, 0 separated, -1 back-flank contact}; only used when the
   backlash ``l_u > 0`` (with ``l_u = 0`` the spring law ``k d`` is linear and damping is on for all
   ``d != 0``, so there is nothing to switch).
@@ -26,6 +27,19 @@ of a mesh period, 1e-15 m of deflection) so that a state resting exactly on a bo
 at standstill at u = 0) cannot trigger an endless chain of zero-length segments.  The time break
 points of the speed and load profiles are also segment boundaries.
 
+Fault errors
+------------
+The run-out ``A_p sin(phi_p + theta_p) + A_w sin(2 pi u / z2 + theta_w)`` (production.eccentricity) and
+the pits ``- depth`` (condition.pitted_teeth, while the pitted tooth is in mesh and
+``start_phase <= p < end_phase``) are added to the error E, which enters ``d = delta + E`` only (contact
+events, elastic force, initial deflection), never the damping rate ``delta_dot``.  The pit edges are
+phase break points, so within a locked mode the pit depth is a constant of the mode
+(:class:`_ModeConsts`); the run-out is smooth in ``u`` and is evaluated as ``sin(2 pi (n + p) / z +
+theta)`` by :func:`_mode_error`, the one place where a locked mode forms E (right-hand sides, contact
+events, outputs, contact re-classification).  The literal helpers :func:`runout_error`,
+:func:`pit_error` and :func:`total_error` transcribe the same paragraph for the self-checks and the
+initial states.  Missing keys (older resolved scenarios) mean no fault.
+
 The mesh force at the output times is evaluated from the (dense-output) states at those times with
 the very same function (``_mesh_force``) that the right-hand side uses, in the mode that was active
 when the sample time was reached.
@@ -34,16 +48,18 @@ Gear trains
 -----------
 Each stage's mesh is a :class:`_Mesh` built from the one-stage-shaped :func:`stage_view` of that
 stage (its own pinion/wheel, stiffness profile, damping, backlash, error mode with its own random
-draw, damaged teeth, and the rated torque referred to its wheel), so the helpers above serve trains
-unchanged.  Every mesh has its own locked mode ``(n_s, k_s, c_s)``; a segment of the integration is
-locked in all of them at once and ends at the first boundary event of *any* mesh (the events of all
-meshes are passed to ``solve_ivp`` together, and the sub-step scan covers all of them).  For N = 1
-the train right-hand side performs the same floating-point operations as the one-stage scene.
+draw, damaged teeth, run-out and pits, and the rated torque referred to its wheel), so the helpers
+above serve trains unchanged.  Every mesh has its own locked mode ``(n_s, k_s, c_s)``; a segment of
+the integration is locked in all of them at once and ends at the first boundary event of *any* mesh
+(the events of all meshes are passed to ``solve_ivp`` together, and the sub-step scan covers all of
+them).  For N = 1 the train right-hand side performs the same floating-point operations as the
+one-stage scene.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 try:  # Python >= 3.11
     import tomllib
@@ -65,6 +81,11 @@ __all__ = [
     "random_l",
     "tooth_error_amplitudes",
     "error_shape",
+    "runout_terms",
+    "runout_error",
+    "pitted_teeth",
+    "pit_error",
+    "total_error",
     "base_stiffness",
     "tooth_factors",
     "reduced_mass",
@@ -143,9 +164,9 @@ def stage_view(scenario: dict, s: int) -> dict:
     (tooth_factors, tooth_error_amplitudes, mesh_force_literal, friction_moments, F_rated, ...).
 
     meta.scene becomes "train-stage" and meta.stage_index = s selects the random draw;
-    production.error_mode and condition.damaged_teeth are the stage's own, condition.friction_coefficient
-    the common one; machine.rated_torque_Nm is the rated torque on this stage's wheel, F_rated,s r_ws,
-    so that F_rated(view) = F_rated,s (to round-off).
+    production.error_mode / eccentricity and condition.damaged_teeth / pitted_teeth are the stage's own
+    (missing keys: none), condition.friction_coefficient the common one; machine.rated_torque_Nm is the
+    rated torque on this stage's wheel, F_rated,s r_ws, so that F_rated(view) = F_rated,s (to round-off).
     """
     st = train_stages(scenario)[s]
     m_wheel = float(stage_F_rated(scenario)[s]) * float(st["wheel"]["base_radius_m"])
@@ -157,10 +178,11 @@ def stage_view(scenario: dict, s: int) -> dict:
             "mesh": st["mesh"],
             "machine": {"rated_torque_Nm": m_wheel},
         },
-        "production": {"error_mode": st["error_mode"]},
+        "production": {"error_mode": st["error_mode"], "eccentricity": st.get("eccentricity", [])},
         "condition": {
             "friction_coefficient": scenario["condition"]["friction_coefficient"],
             "damaged_teeth": st.get("damaged_teeth", []),
+            "pitted_teeth": st.get("pitted_teeth", []),
         },
     }
 
@@ -240,6 +262,67 @@ def error_shape(p, a: float, e_i):
     return np.where(p < a, rise, fall)
 
 
+def runout_terms(scenario: dict) -> list[tuple[float, float, int]]:
+    """Run-out entries of production.eccentricity (missing key: none) as (A, theta, z): A = amplitude_um
+    * 1e-6, theta = radians(phase_deg) and z the teeth of that gear, so that each term is
+    A sin(2 pi u / z + theta) (pinion: phi_p = 2 pi u / z1; wheel: phi_w* = 2 pi u / z2)."""
+    teeth = {g: int(scenario["design"][g]["teeth"]) for g in ("pinion", "wheel")}
+    out = []
+    for entry in scenario.get("production", {}).get("eccentricity", []):
+        if entry["gear"] not in teeth:
+            raise ValueError(f"eccentricity: unknown gear {entry['gear']!r}")
+        amp = float(entry["amplitude_um"]) * 1e-6
+        out.append((amp, math.radians(float(entry["phase_deg"])), teeth[entry["gear"]]))
+    return out
+
+
+def runout_error(scenario: dict, u):
+    """Run-out error + A_p sin(phi_p + theta_p) + A_w sin(phi_w* + theta_w) at the mesh coordinate u."""
+    u = np.asarray(u, dtype=float)
+    E = np.zeros(u.shape)
+    for amp, theta, z in runout_terms(scenario):
+        E = E + amp * np.sin(TWO_PI * u / z + theta)
+    return E
+
+
+def pitted_teeth(scenario: dict) -> list[tuple[str, int, float, float, float]]:
+    """condition.pitted_teeth (missing key: none) as (gear, tooth, depth in m, start_phase, end_phase)."""
+    z = {g: int(scenario["design"][g]["teeth"]) for g in ("pinion", "wheel")}
+    out = []
+    for entry in scenario.get("condition", {}).get("pitted_teeth", []):
+        gear, tooth = entry["gear"], int(entry["tooth"])
+        lo, hi = float(entry["start_phase"]), float(entry["end_phase"])
+        if gear not in z or not 0 <= tooth < z[gear]:
+            raise ValueError(f"pitted tooth {tooth} of gear {gear!r} does not exist")
+        if not 0.0 <= lo < hi <= 1.0:
+            raise ValueError(f"pit phases need 0 <= start_phase < end_phase <= 1, got {lo}, {hi}")
+        out.append((gear, tooth, float(entry["depth_um"]) * 1e-6, lo, hi))
+    return out
+
+
+def pit_error(scenario: dict, p, i, j):
+    """Pitting error: - depth while the pitted tooth is in mesh (pinion tooth i, wheel tooth j) and
+    start_phase <= p < end_phase; pits on both teeth of a pair add."""
+    p = np.asarray(p, dtype=float)
+    E = np.zeros(np.broadcast(p, i, j).shape)
+    for gear, tooth, depth, lo, hi in pitted_teeth(scenario):
+        in_mesh = (np.asarray(i) if gear == "pinion" else np.asarray(j)) == tooth
+        E = E - np.where(in_mesh & (lo <= p) & (p < hi), depth, 0.0)
+    return E
+
+
+def total_error(scenario: dict, u):
+    """The whole error E at the mesh coordinate u: triangular shape (eq. 6) + run-out + pits."""
+    u = np.asarray(u, dtype=float)
+    n = np.floor(u).astype(np.int64)
+    p = u - n
+    i = np.mod(n, int(scenario["design"]["pinion"]["teeth"]))
+    j = np.mod(n, int(scenario["design"]["wheel"]["teeth"]))
+    a = float(scenario["production"]["error_mode"]["a"])
+    E = error_shape(p, a, tooth_error_amplitudes(scenario)[i])
+    return E + runout_error(scenario, u) + pit_error(scenario, p, i, j)
+
+
 def base_stiffness(p, mesh: dict):
     """k_z(p) without tooth factors ("contact-ratio" or "table")."""
     p = np.asarray(p, dtype=float)
@@ -288,6 +371,7 @@ def mesh_force_literal(scenario: dict, u, delta, delta_dot) -> dict:
     """Vectorised, literal transcription of the mesh-force paragraph (used by the self-checks).
 
     u: pinion mesh coordinate phi_p z1 / (2 pi); delta = r1 phi_p - r2 phi_w; delta_dot its rate.
+    E is the total error (triangular shape, run-out, pits); it enters d only, never the damping.
     """
     d_ = scenario["design"]
     mesh = d_["mesh"]
@@ -301,6 +385,7 @@ def mesh_force_literal(scenario: dict, u, delta, delta_dot) -> dict:
     k = base_stiffness(p, mesh) * f[i] * g[j]
     e_i = tooth_error_amplitudes(scenario)[i]
     E = error_shape(p, float(scenario["production"]["error_mode"]["a"]), e_i)
+    E = E + runout_error(scenario, u) + pit_error(scenario, p, i, j)  # fault errors: in d only
     d = np.asarray(delta, dtype=float) + E
     lu = float(mesh["backlash_um"]) * 1e-6
     F_el = k * np.maximum(d - lu, np.minimum(d + lu, 0.0))
@@ -349,11 +434,7 @@ def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     M_p = F0 * r1
     f, g = tooth_factors(scenario)
     k0 = float(base_stiffness(0.0, mesh)) * f[0] * g[0]
-    E0 = float(
-        error_shape(
-            0.0, float(scenario["production"]["error_mode"]["a"]), tooth_error_amplitudes(scenario)[0]
-        )
-    )  # non-zero only for a = 0
+    E0 = float(total_error(scenario, 0.0))  # total error at p = 0, tooth 0 (fault errors included)
     delta0 = F0 / k0 + lu - E0 if F0 != 0.0 else 0.0
     if scene == "muller":
         q0[0] = delta0
@@ -417,8 +498,7 @@ def _train_initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
         i, j = n % z_p[s], n % z_w[s]
         f, g = tooth_factors(view)
         k = float(base_stiffness(p, mesh)) * f[i] * g[j]
-        a = float(view["production"]["error_mode"]["a"])
-        E = float(error_shape(p, a, tooth_error_amplitudes(view)[i]))
+        E = float(total_error(view, u))  # fault errors included
         lu = float(mesh["backlash_um"]) * 1e-6
         if F[s] == 0.0:
             delta = 0.0
@@ -448,24 +528,59 @@ def phase_breakpoints(scenario: dict) -> np.ndarray:
     pts.append(float(scenario["production"]["error_mode"]["a"]))
     if scenario["meta"]["scene"] != "muller" and float(scenario["condition"]["friction_coefficient"]) != 0.0:
         pts.append(float(mesh["pitch_point_phase"]))
+    for _gear, _tooth, _depth, lo, hi in pitted_teeth(scenario):  # pit edges
+        pts += [lo, hi % 1.0]
     pts = np.unique([x for x in pts if 0.0 <= x < 1.0])
-    return pts
+    # merge points closer than 1e-9 (e.g. a pit edge 0.3 and h = 0.30000000000000004): no degenerate
+    # intervals narrower than the event hysteresis
+    keep = [pts[0]]
+    for x in pts[1:]:
+        if x - keep[-1] > 1e-9 and 1.0 - x > 1e-9:
+            keep.append(x)
+    return np.array(keep)
 
 
 # ----------------------------------------------------------------------------------------------
 # Locked-mode mesh law (used by the right-hand side AND for the outputs)
 # ----------------------------------------------------------------------------------------------
-def _mesh_force(mc: tuple, p, delta, delta_dot):
+class _ModeConsts(NamedTuple):
+    """Constants of one mesh in a locked mode (phase interval k of mesh period n, contact mode c)."""
+
+    fg: float  # tooth factors f_i g_j
+    kA: float  # base stiffness k_z = kA + kS (p - bA) on the interval
+    kS: float
+    bA: float
+    e_i: float  # triangular error e_i (Ea + Eb p) on the interval
+    Ea: float
+    Eb: float
+    c: int  # contact mode: 1 drive flank, 0 separated, -1 back flank
+    lu: float  # half backlash
+    Cf: float  # damping C_z f_i g_j
+    pit: float  # depth of the pits active on this interval (constant there: pit edges are breakpoints)
+    nf: float  # n, so that u = n + p
+    runout: tuple  # (A, 2 pi / z, theta) per run-out term: A sin(2 pi u / z + theta)
+
+
+def _mode_error(mc: _ModeConsts, p):
+    """Total error E in a locked mode at p = u - n (float or array): triangle - pit + run-out."""
+    E = mc.e_i * (mc.Ea + mc.Eb * p) - mc.pit
+    if mc.runout:
+        u = mc.nf + p
+        sin = math.sin if isinstance(u, float) else np.sin
+        for amp, w, theta in mc.runout:
+            E = E + amp * sin(w * u + theta)
+    return E
+
+
+def _mesh_force(mc: _ModeConsts, p, delta, delta_dot):
     """Mesh force F = F_el + F_t in a locked mode; works on floats and on numpy arrays.
 
-    mc = (fg, kA, kS, bA, e_i, Ea, Eb, c, lu, Cf): effective stiffness fg (kA + kS (p - bA)),
-    error e_i (Ea + Eb p), contact mode c (0: separated), half backlash lu, damping Cf = C_z fg.
+    d = delta + E with the total error E of :func:`_mode_error`; the damping uses delta_dot only.
     """
-    fg, kA, kS, bA, e_i, Ea, Eb, c, lu, Cf = mc
-    if c == 0:
+    if mc.c == 0:
         return 0.0 * (p + delta + delta_dot)
-    d = delta + e_i * (Ea + Eb * p)
-    return fg * (kA + kS * (p - bA)) * (d - c * lu) + Cf * delta_dot
+    d = delta + _mode_error(mc, p)
+    return mc.fg * (mc.kA + mc.kS * (p - mc.bA)) * (d - mc.c * mc.lu) + mc.Cf * delta_dot
 
 
 class _Mesh:
@@ -493,6 +608,8 @@ class _Mesh:
         self.a = float(sc["production"]["error_mode"]["a"])
         self.f, self.g = tooth_factors(sc)
         self.e_amp = tooth_error_amplitudes(sc)
+        self.runout = tuple((amp, TWO_PI / z, theta) for amp, theta, z in runout_terms(sc))
+        self.pits = pitted_teeth(sc)
         self.Frated = F_rated(sc) if Frated is None else float(Frated)
         # phase intervals
         b = phase_breakpoints(sc)
@@ -521,11 +638,30 @@ class _Mesh:
         self.omega_n = math.sqrt(kmax / self.m_red)
 
     # -- mode constants ---------------------------------------------------------------------
-    def mode_consts(self, n: int, k: int, c: int) -> tuple:
+    def mode_consts(self, n: int, k: int, c: int) -> _ModeConsts:
         kA, kS, Ea, Eb, _s = self.iv[k]
-        fg = self.f[n % self.z1] * self.g[n % self.z2]
-        e_i = self.e_amp[n % self.z1]
-        return (fg, kA, kS, float(self.bA[k]), e_i, Ea, Eb, c, self.lu, self.Cz * fg)
+        i, j = n % self.z1, n % self.z2
+        fg = self.f[i] * self.g[j]
+        mid = 0.5 * (float(self.bA[k]) + float(self.bB[k]))
+        pit = 0.0
+        for gear, tooth, depth, lo, hi in self.pits:
+            if tooth == (i if gear == "pinion" else j) and lo <= mid < hi:
+                pit += depth
+        return _ModeConsts(
+            fg=fg,
+            kA=kA,
+            kS=kS,
+            bA=float(self.bA[k]),
+            e_i=self.e_amp[i],
+            Ea=Ea,
+            Eb=Eb,
+            c=c,
+            lu=self.lu,
+            Cf=self.Cz * fg,
+            pit=pit,
+            nf=float(n),
+            runout=self.runout,
+        )
 
     def phase_mode(self, u: float, u_dot: float) -> tuple[int, int]:
         n = math.floor(u)
@@ -693,7 +829,6 @@ class _Model(_Mesh):
         lo = n + float(self.bA[k]) - _ETA_U
         hi = n + float(self.bB[k]) + _ETA_U
         kin = self.kin
-        e_i, Ea, Eb = mc[4], mc[5], mc[6]
         nf = float(n)
 
         def ev_up(t, y):
@@ -710,7 +845,7 @@ class _Model(_Mesh):
 
             def dfun(t, y):
                 u, delta, _ = kin(t, y, theta)
-                return delta + e_i * (Ea + Eb * (u - nf))
+                return delta + _mode_error(mc, u - nf)
 
             for offset, direction, new_c in _contact_edges(self.lu, c):
 
@@ -725,8 +860,7 @@ class _Model(_Mesh):
     def deflection(self, n, k, t, y, theta) -> tuple[float, float]:
         """d = delta + E in mode (n, k) and its rate (for re-classifying the contact mode)."""
         u, delta, ddot = self.kin(t, y, theta)
-        _, _, _, _, e_i, Ea, Eb, *_ = self.mode_consts(n, k, 0)
-        return delta + e_i * (Ea + Eb * (u - n)), ddot
+        return delta + _mode_error(self.mode_consts(n, k, 0), u - n), ddot
 
     def default_atol(self, rtol: float) -> np.ndarray:
         if self.scene == "muller":
@@ -843,8 +977,7 @@ class _Train:
     def deflection(self, s: int, n: int, k: int, y) -> tuple[float, float]:
         """d = delta + E of stage s in phase mode (n, k), and its rate."""
         u, delta, ddot = self.kin(s, y)
-        _, _, _, _, e_i, Ea, Eb, *_ = self.meshes[s].mode_consts(n, k, 0)
-        return delta + e_i * (Ea + Eb * (u - n)), ddot
+        return delta + _mode_error(self.meshes[s].mode_consts(n, k, 0), u - n), ddot
 
     def initial_modes(self, y) -> list[list[int]]:
         modes = []
@@ -937,12 +1070,11 @@ class _Train:
             events += [ev_up, ev_down]
             actions += [(s, "phase", +1), (s, "phase", -1)]
             if m.lu > 0.0:
-                e_i, Ea, Eb = mcs[s][4], mcs[s][5], mcs[s][6]
                 for offset, direction, new_c in _contact_edges(m.lu, c):
 
-                    def ev(t, y, offset=offset, c_=(ip, iw, cz, r1, r2, e_i, Ea, Eb, float(n))):
-                        ip, iw, cz, r1, r2, e_i, Ea, Eb, nf = c_
-                        return r1 * y[ip] - r2 * y[iw] + e_i * (Ea + Eb * (y[ip] * cz - nf)) + offset
+                    def ev(t, y, offset=offset, c_=(ip, iw, cz, r1, r2, mcs[s])):
+                        ip, iw, cz, r1, r2, mc = c_
+                        return r1 * y[ip] - r2 * y[iw] + _mode_error(mc, y[ip] * cz - mc.nf) + offset
 
                     ev.terminal, ev.direction = True, direction
                     events.append(ev)

@@ -9,7 +9,8 @@ the locked-mode mesh law and the segment integrator with its missed-event scan).
 Model
 -----
 A ``one-stage`` scenario is rewritten as a 1-stage train (coupling = shaft 0, output shaft = shaft 1,
-production.error_mode and condition.damaged_teeth moved into the stage), which is the same system.
+production.error_mode / eccentricity and condition.damaged_teeth / pitted_teeth moved into the stage),
+which is the same system.
 State ``y = [q, v]`` with ``q = [motor, pinion_1, wheel_1, ..., pinion_N, wheel_N, machine, lateral...]``;
 the lateral coordinates follow in the order stage 1 pinion (x, y as free), stage 1 wheel, stage 2
 pinion, ...
@@ -17,6 +18,9 @@ pinion, ...
 Per stage (geometry ``n``, ``m = s1 (-n_y, n_x)``):
 ``delta = r1 phi_p - r2 phi_w + (u_p - u_w) . n``; F, T, rho_1, rho_2 as in the torsional model;
 pinion: moment ``-r1 F + T rho_1``, force ``-F n + T m``; wheel: ``+r2 F - T rho_2``, ``+F n - T m``.
+Fault errors (run-out, pits) are part of the error E and enter ``d = delta + E`` only, exactly as in
+the torsional reference (its locked-mode constants and ``_mode_error``; the initial deflection uses
+``total_error``); the lateral projection is part of ``delta`` and so sits beside them in ``d``.
 Bearing forces: linear ``-(k_x x + C_x x', k_y y + C_y y')``; hertzian
 ``-max(k_b (r - c)^n + C u'.u / r, 0) u / r`` for ``r > c``, else 0.
 
@@ -141,6 +145,8 @@ def as_train(scenario: dict) -> dict:
                     "mesh": d["mesh"],
                     "error_mode": scenario["production"]["error_mode"],
                     "damaged_teeth": scenario["condition"].get("damaged_teeth", []),
+                    "eccentricity": scenario["production"].get("eccentricity", []),
+                    "pitted_teeth": scenario["condition"].get("pitted_teeth", []),
                 }
             ],
         }
@@ -335,8 +341,7 @@ class _LatTrain:
 
     def deflection(self, s, n, k, y):
         u, delta, ddot = self.kin(s, y)
-        _, _, _, _, e_i, Ea, Eb, *_ = self.meshes[s].mode_consts(n, k, 0)
-        return delta + e_i * (Ea + Eb * (u - n)), ddot
+        return delta + ref._mode_error(self.meshes[s].mode_consts(n, k, 0), u - n), ddot
 
     def initial_modes(self, y):
         modes = []
@@ -483,13 +488,11 @@ class _LatTrain:
             events += [ev_up, ev_down]
             actions += [("phase", s, +1), ("phase", s, -1)]
             if m.lu > 0.0:
-                e_i, Ea, Eb = mcs[s][4], mcs[s][5], mcs[s][6]
                 for offset, direction, new_c in ref._contact_edges(m.lu, c):
 
-                    def ev(t, y, offset=offset, s=s, c_=(e_i, Ea, Eb, float(n))):
-                        e_i, Ea, Eb, nf = c_
+                    def ev(t, y, offset=offset, s=s, mc=mcs[s]):
                         u, delta, _ = self.kin(s, y)
-                        return delta + e_i * (Ea + Eb * (u - nf)) + offset
+                        return delta + ref._mode_error(mc, u - mc.nf) + offset
 
                     ev.terminal, ev.direction = True, direction
                     events.append(ev)
@@ -620,8 +623,7 @@ def initial_state_lateral(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
         i, j = n % z_p[s], n % z_w[s]
         f, g = ref.tooth_factors(view)
         k = float(ref.base_stiffness(p, mesh)) * f[i] * g[j]
-        a = float(view["production"]["error_mode"]["a"])
-        E = float(ref.error_shape(p, a, ref.tooth_error_amplitudes(view)[i]))
+        E = float(ref.total_error(view, u))  # fault errors included
         lu = float(mesh["backlash_um"]) * 1e-6
         if F[s] == 0.0:
             delta = 0.0
