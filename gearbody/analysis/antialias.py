@@ -17,6 +17,8 @@ are not those of the instantaneous one.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from scipy.signal import oaconvolve
 
@@ -39,6 +41,24 @@ def _kernel(tau_s: np.ndarray, rate_hz: float, half_width_s: float, beta: float)
     x = np.clip(tau_s / half_width_s, -1.0, 1.0)
     window = np.i0(beta * np.sqrt(1.0 - x * x)) / np.i0(beta)
     return np.where(np.abs(tau_s) <= half_width_s, 2 * fc * np.sinc(2 * fc * tau_s) * window, 0.0)
+
+
+@lru_cache(maxsize=16)
+def _filter_tables(rate_hz: float, oversampling: int, stopband_db: float):
+    """Fine-grid taps (sum 1) and the tabulated step response (tau, S) of the low-pass; cached."""
+    half_w = KERNEL_HALF_WIDTH_SAMPLES / rate_hz
+    beta = _kaiser_beta(stopband_db)
+    L = KERNEL_HALF_WIDTH_SAMPLES * oversampling
+    dt = 1.0 / (oversampling * rate_hz)
+    taps = _kernel(np.arange(-L, L + 1) * dt, rate_hz, half_w, beta)
+    taps /= taps.sum()
+    s_tau = np.linspace(-half_w, half_w, 16 * 2 * KERNEL_HALF_WIDTH_SAMPLES * 64 + 1)
+    h = _kernel(s_tau, rate_hz, half_w, beta)
+    s_cum = np.concatenate([[0.0], np.cumsum(0.5 * (h[1:] + h[:-1]) * np.diff(s_tau))])
+    s_cum /= s_cum[-1]
+    for array in (taps, s_tau, s_cum):
+        array.flags.writeable = False
+    return taps, s_tau, s_cum
 
 
 def level_crossings(t_s: np.ndarray, g: np.ndarray, level: float = 0.0) -> np.ndarray:
@@ -94,7 +114,6 @@ def band_limited_samples(
     dt = (t[-1] - t[0]) / (t.size - 1)
     rate = 1.0 / (M * dt)
     half_w = KERNEL_HALF_WIDTH_SAMPLES / rate
-    beta = _kaiser_beta(stopband_db)
 
     # 1. Jumps: one per fine interval, size = right limit - left limit, each limit extrapolated from
     #    its own side by a quadratic (error ~ dt^3 x'''), or linearly / constant next to other jumps.
@@ -114,17 +133,12 @@ def band_limited_samples(
 
     # 3. Filter the rest with the sampled kernel (odd-reflection padding keeps value and slope at the ends).
     L = KERNEL_HALF_WIDTH_SAMPLES * M
-    taps = _kernel(np.arange(-L, L + 1) * dt, rate, half_w, beta)
-    taps /= taps.sum()
+    taps, s_tau, s_cum = _filter_tables(rate, M, stopband_db)
     padded = np.pad(rest, L, mode="reflect", reflect_type="odd")
     y = oaconvolve(padded, taps, mode="valid")[::M]
 
     # 4. Add the filtered steps: dx * S(t_k - t_jump), S the kernel's step response.
     t_out = t[::M]
-    s_tau = np.linspace(-half_w, half_w, 16 * 2 * KERNEL_HALF_WIDTH_SAMPLES * 64 + 1)
-    h = _kernel(s_tau, rate, half_w, beta)
-    s_cum = np.concatenate([[0.0], np.cumsum(0.5 * (h[1:] + h[:-1]) * np.diff(s_tau))])
-    s_cum /= s_cum[-1]
     k0 = np.ceil((tj - half_w - t_out[0]) * rate - 1e-9).astype(int)
     span = 2 * KERNEL_HALF_WIDTH_SAMPLES + 2
     kk = k0[:, None] + np.arange(span)[None, :]
