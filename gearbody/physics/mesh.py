@@ -197,9 +197,13 @@ def mesh_error_m(pinion_angle_rad: float, P: np.ndarray) -> float:
     z1, z2 = int(P[I_Z1]), int(P[I_Z2])
     u = pinion_angle_rad * z1 / (2.0 * math.pi)
     n = math.floor(u)
-    p = u - n
-    i = int(n % z1)
-    j = int(n % z2)
+    return _error_at(pinion_angle_rad, u - n, int(n % z1), int(n % z2), P)
+
+
+@njit(cache=True)
+def _error_at(pinion_angle_rad: float, p: float, i: int, j: int, P: np.ndarray) -> float:
+    """:func:`mesh_error_m` with the mesh phase and the teeth in mesh already known (hot path)."""
+    z1, z2 = int(P[I_Z1]), int(P[I_Z2])
     E = tooth_error_m(p, i, P)
     if P[I_ECC_P] != 0.0:
         E += P[I_ECC_P] * math.sin(pinion_angle_rad + P[I_ECC_P_PHASE])
@@ -224,7 +228,7 @@ def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float,
     j = int(n % z2)
     factor = tooth_pair_factor(i, j, P)
     k = stiffness_at_phase(p, P) * factor
-    d = delta_m + mesh_error_m(pinion_angle_rad, P)
+    d = delta_m + _error_at(pinion_angle_rad, p, i, j, P)
     lu = P[I_LU]
     if d > lu:
         F = k * (d - lu) + P[I_CZ] * factor * delta_rate_m_s
