@@ -83,9 +83,10 @@ def report_sections(result: Result) -> dict[str, Any]:
         f_max = min(result.sample_rate_hz / 2, 6 * f_mesh)
         sources = KinematicSources.gear_train(f_mesh / z1, teeth)
         lines = kinematic_lines(sources, f_max, harmonics=6, sidebands=3, shaft_orders=30)
-        tolerance = max(1.5 * spec.resolution_hz, 0.0)
-        peaks = label_peaks(spec, lines, tolerance_hz=tolerance, min_prominence_db=12.0, max_peaks=40,
-                            f_max_hz=f_max)
+        peaks = label_peaks(
+            spec, lines, tolerance_hz=1.5 * spec.resolution_hz, min_prominence_db=12.0, max_peaks=40,
+            f_max_hz=f_max,
+        )
         fig = _figure((1100, 500), 100)
         plot_labelled_spectrum(spec, peaks, ax=fig.add_subplot(1, 1, 1), title=f"spectrum of {name}",
                                unit=unit, f_max_hz=f_max)

@@ -1,4 +1,4 @@
-"""Shared pieces of the reproduction scripts: steady runs, claims, and the results files.
+"""Shared pieces of the reproduction scripts: claims and the results files.
 
 Each script ``figs_*.py`` checks the paper's claims for one figure group with ONE documented
 parameter set per system (the shipped scenes; nothing is tuned per claim) and writes
@@ -29,15 +29,6 @@ class Claim:
 
     def __post_init__(self):
         self.passed = bool(self.passed)  # numpy bools are not JSON
-
-
-def steady(speed_fraction: float = 1.0, t_end_s: float = 0.3, load_fraction: float = 1.0) -> list[str]:
-    return [
-        'operation.initial_state="steady"',
-        f"operation.speed_profile={{time_s=[0.0],fraction=[{speed_fraction}]}}",
-        f"operation.load_profile={{time_s=[0.0],fraction=[{load_fraction}]}}",
-        f"operation.t_end_s={t_end_s}",
-    ]
 
 
 def write_results(name: str, title: str, claims: list[Claim], notes: list[str], figures: list[Path],

@@ -17,8 +17,9 @@ import numpy as np
 from gearbody.engine import simulate
 from gearbody.model import load_scenario
 from gearbody.plots import _figure, _save
+from gearbody.resonance import steady_overrides
 
-from .common import RESULTS_DIR, Claim, Timer, steady, write_results
+from .common import RESULTS_DIR, Claim, Timer, write_results
 
 SETTLE_S, RECORD_S = 0.1, 0.1
 MODES = {"a: E(0.1, e, 0)": (0.1, 1.0), "b: E(0.5, e, 0)": (0.5, 1.0), "c: E(0.5, -e, 0)": (0.5, -1.0)}
@@ -28,7 +29,7 @@ def kd_max(a: float, e_um: float) -> float:
     sc = load_scenario(
         "one-stage",
         [
-            *steady(1.0, SETTLE_S + RECORD_S),
+            *steady_overrides(1.0, SETTLE_S + RECORD_S),
             f"production.error_mode={{a={a},e_um={e_um},r=0.0}}",
             "design.coupling.damping_Nms_per_rad=0.0",
         ],

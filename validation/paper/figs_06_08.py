@@ -18,9 +18,9 @@ from gearbody.analysis import fold_over_mesh_period
 from gearbody.engine import scene_modes, simulate
 from gearbody.model import load_scenario
 from gearbody.plots import _figure, _save
-from gearbody.resonance import kd_speed_sweep, plot_campbell, plot_kd_against_speed
+from gearbody.resonance import kd_speed_sweep, plot_campbell, plot_kd_against_speed, steady_overrides
 
-from .common import RESULTS_DIR, Claim, Timer, steady, write_results
+from .common import RESULTS_DIR, Claim, Timer, write_results
 
 ERROR = "production.error_mode={a=0.5,e_um=10.0,r=0.0}"
 SETTLE_S, RECORD_S = 0.1, 0.1
@@ -38,7 +38,8 @@ def main(quick: bool = False) -> None:
         cases = {"under resonance (Fig. 6)": 0.6, "at resonance (Fig. 7)": at, "over resonance (Fig. 8)": 1.3}
         folded, kd_max = {}, {}
         for label, fraction in cases.items():
-            res = simulate(load_scenario("two-wheel", [ERROR, *steady(fraction, SETTLE_S + RECORD_S)]))
+            overrides = [ERROR, *steady_overrides(fraction, SETTLE_S + RECORD_S)]
+            res = simulate(load_scenario("two-wheel", overrides))
             window = res.time_s >= SETTLE_S
             angle = res["pinion_angle_rad"][window]
             folded[label] = fold_over_mesh_period(res.kd[window], angle, z1, bins=100)
