@@ -15,7 +15,7 @@ import numpy as np
 from ..model import Scenario
 from ..physics import mesh_parameters_from_scenario, pack_drive_parameters, steady_slip
 from ..physics.lateral import mesh_directions, static_bearing_displacement_m
-from ..physics.mesh import mesh_error_m, mesh_phase_series, stiffness_at_phase, tooth_pair_factor
+from ..physics.mesh import pair_in_mesh, stiffness_at_phase
 
 
 @dataclass(frozen=True)
@@ -219,15 +219,15 @@ def static_deflection_m(scenario: Scenario, stage: int, pinion_angle_rad: float,
     if force_N == 0.0:
         return 0.0
     P = mesh_parameters_from_scenario(scenario, stage)
-    p, i, j = (x[0] for x in mesh_phase_series(np.array([pinion_angle_rad]), P))
-    k = stiffness_at_phase(p, P) * tooth_pair_factor(i, j, P)
+    p, factor, error_m = pair_in_mesh(pinion_angle_rad, P)
+    k = stiffness_at_phase(p, P) * factor
     if k <= 0:
         raise ValueError(
             f"stage {stage + 1}: the teeth in mesh at the start carry no load (stiffness factor 0): "
             "start from rest"
         )
     st = scenario.stages[stage]
-    return force_N / k + st.mesh.backlash_um * 1e-6 - mesh_error_m(pinion_angle_rad, P)
+    return force_N / k + st.mesh.backlash_um * 1e-6 - error_m
 
 
 def initial_state(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:

@@ -13,6 +13,14 @@ The error ``E`` is the tooth error mode plus two production/condition faults: a 
 run-out of either gear, ``A sin(phi + theta)`` along the line of action (wheel angle taken as
 ``phi_p z1 / z2``), and a pit on a tooth flank, ``-depth`` while that tooth's pair is between two mesh
 phases (material missing: the pair deflects less).
+
+Regularisation (``transition_width`` w, a fraction of the mesh period; 0 = the sharp law of the paper):
+every jump of the law at fixed deflection, i.e. the single/double contact switches of k_z, the change of
+tooth pair at p = 0 (stiffness factors, errors), the pit edges and the friction reversals (pitch point and
+tooth change), is spread over ``|p - p_jump| < w / 2`` by the C2 smooth step :func:`smooth_step`.
+Across the tooth change the factor and the error are blended between the outgoing and incoming pairs
+(each evaluated with its own phase, p + 1 or p - 1). Each ramp is antisymmetric about its centre, so the
+mean stiffness over a period is unchanged. docs/scenario.md, "Transition width".
 """
 
 from __future__ import annotations
@@ -23,6 +31,7 @@ import numpy as np
 from numba import njit
 
 from .errors import tooth_error_depths_m
+from .motor import load_torque_at, motor_torque_at
 
 # Layout of the packed parameter array.
 I_R1, I_R2, I_Z1, I_Z2 = 0, 1, 2, 3
@@ -31,6 +40,7 @@ I_CZ, I_LU, I_MU, I_PITCH = 8, 9, 10, 11
 I_ARM1, I_ARM2, I_PB, I_A = 12, 13, 14, 15
 I_NTAB = 16
 I_ECC_P, I_ECC_P_PHASE, I_ECC_W, I_ECC_W_PHASE = 17, 18, 19, 20  # run-out amplitudes (m), phases (rad)
+I_WIDTH = 21  # transition width w, fraction of the mesh period (0: sharp law)
 I_HEADER = 24
 # after the header: e_i (z1), pinion factors (z1), wheel factors (z2), table phases (n), table k (n),
 # pit depth / start phase / end phase per pinion tooth (3 z1), then per wheel tooth (3 z2)
@@ -62,6 +72,7 @@ def pack_mesh_parameters(
     runout_phase_rad: tuple[float, float] = (0.0, 0.0),
     pinion_pits: np.ndarray | None = None,
     wheel_pits: np.ndarray | None = None,
+    transition_width: float = 0.0,
 ) -> np.ndarray:
     """Pack everything the mesh law needs into one float64 array (see module docstring)."""
     f = np.ones(z1) if pinion_factors is None else np.asarray(pinion_factors, float)
@@ -95,6 +106,7 @@ def pack_mesh_parameters(
     head[I_NTAB] = tp.size
     head[I_ECC_P], head[I_ECC_W] = runout_m
     head[I_ECC_P_PHASE], head[I_ECC_W_PHASE] = runout_phase_rad
+    head[I_WIDTH] = transition_width
     return np.concatenate([head, e, f, g, tp, tk, pits_p.T.ravel(), pits_w.T.ravel()])
 
 
@@ -137,14 +149,29 @@ def mesh_parameters_from_scenario(scenario, stage: int = 0, *, friction: bool = 
         runout_phase_rad=(runout_phase[0], runout_phase[1]),
         pinion_pits=pits["pinion"],
         wheel_pits=pits["wheel"],
+        transition_width=mesh.transition_width,
     )
+
+
+@njit(cache=True)
+def smooth_step(x: float) -> float:
+    """0 for x <= -1/2, 1 for x >= 1/2, C2 quintic in between (value 1/2 at 0, antisymmetric)."""
+    if x <= -0.5:
+        return 0.0
+    if x >= 0.5:
+        return 1.0
+    u = x + 0.5
+    return u * u * u * (10.0 + u * (6.0 * u - 15.0))
 
 
 @njit(cache=True)
 def stiffness_at_phase(p: float, P: np.ndarray) -> float:
     """k_z(p) of a healthy pair, N/m: single/double contact from the contact ratio, or a periodic table."""
     if P[I_KIND] == PROFILE_CONTACT_RATIO:
-        h = P[I_HALF_DOUBLE]
+        h, w = P[I_HALF_DOUBLE], P[I_WIDTH]
+        if w > 0.0 and h > 0.0:
+            share = 1.0 - smooth_step((p - h) / w) + smooth_step((p - 1.0 + h) / w)
+            return P[I_KSINGLE] + (P[I_KDOUBLE] - P[I_KSINGLE]) * share
         return P[I_KDOUBLE] if (p < h or p >= 1.0 - h) else P[I_KSINGLE]
     z1, z2, n = int(P[I_Z1]), int(P[I_Z2]), int(P[I_NTAB])
     o = I_HEADER + 2 * z1 + z2
@@ -170,7 +197,7 @@ def tooth_pair_factor(i: int, j: int, P: np.ndarray) -> float:
 @njit(cache=True)
 def error_shape(p: float, a: float) -> float:
     """Triangular error shape of Fig. 4 (b, c): 0 at p = 0 and 1, maximum 1 at p = a."""
-    if p < a:
+    if a > 0.0 and p < a:  # (p outside [0, 1) extends the straight lines: regularised tooth change)
         return p / a
     return (1.0 - p) / (1.0 - a) if a < 1.0 else 1.0
 
@@ -186,6 +213,10 @@ def _pit_m(p: float, tooth: int, offset: int, teeth: int, P: np.ndarray) -> floa
     depth = P[offset + tooth]
     if depth == 0.0:
         return 0.0
+    w = P[I_WIDTH]
+    if w > 0.0:
+        start, end = P[offset + teeth + tooth], P[offset + 2 * teeth + tooth]
+        return depth * (smooth_step((p - start) / w) - smooth_step((p - end) / w))
     if P[offset + teeth + tooth] <= p < P[offset + 2 * teeth + tooth]:
         return depth
     return 0.0
@@ -193,11 +224,39 @@ def _pit_m(p: float, tooth: int, offset: int, teeth: int, P: np.ndarray) -> floa
 
 @njit(cache=True)
 def mesh_error_m(pinion_angle_rad: float, P: np.ndarray) -> float:
-    """Total error E at a pinion angle, m: tooth error mode + run-out of both gears - pits."""
+    """Total error E at a pinion angle, m: tooth error mode + run-out of both gears - pits (regularised
+    across the tooth change when the transition width is non-zero)."""
+    return pair_in_mesh(pinion_angle_rad, P)[2]
+
+
+@njit(cache=True)
+def pair_in_mesh(pinion_angle_rad: float, P: np.ndarray):
+    """Mesh phase p, stiffness factor and error E (m) of the tooth pair in mesh at a pinion angle.
+
+    With a transition width w, within w/2 of the tooth change the factor and the error are blended
+    between the outgoing and incoming pairs, each evaluated at its own phase (p + 1 or p - 1).
+    """
     z1, z2 = int(P[I_Z1]), int(P[I_Z2])
     u = pinion_angle_rad * z1 / (2.0 * math.pi)
     n = math.floor(u)
-    return _error_at(pinion_angle_rad, u - n, int(n % z1), int(n % z2), P)
+    p = u - n
+    i = int(n % z1)
+    j = int(n % z2)
+    factor = tooth_pair_factor(i, j, P)
+    E = _error_at(pinion_angle_rad, p, i, j, P)
+    w = P[I_WIDTH]
+    if w > 0.0:
+        if p < 0.5 * w:
+            o, po, s = -1, p + 1.0, 1.0 - smooth_step(p / w)
+        elif p > 1.0 - 0.5 * w:
+            o, po, s = 1, p - 1.0, smooth_step((p - 1.0) / w)
+        else:
+            o, po, s = 0, p, 0.0
+        if o != 0:
+            io, jo = (i + o) % z1, (j + o) % z2
+            factor += s * (tooth_pair_factor(io, jo, P) - factor)
+            E += s * (_error_at(pinion_angle_rad, po, io, jo, P) - E)
+    return p, factor, E
 
 
 @njit(cache=True)
@@ -220,15 +279,9 @@ def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float,
     ``pinion_angle_rad`` sets the mesh phase and the teeth in mesh; ``delta_m`` is the deflection
     along the line of action (r1 phi_p - r2 phi_w, plus centre motions in lateral models).
     """
-    z1, z2 = int(P[I_Z1]), int(P[I_Z2])
-    u = pinion_angle_rad * z1 / (2.0 * math.pi)
-    n = math.floor(u)
-    p = u - n
-    i = int(n % z1)
-    j = int(n % z2)
-    factor = tooth_pair_factor(i, j, P)
+    p, factor, E = pair_in_mesh(pinion_angle_rad, P)
     k = stiffness_at_phase(p, P) * factor
-    d = delta_m + _error_at(pinion_angle_rad, p, i, j, P)
+    d = delta_m + E
     lu = P[I_LU]
     if d > lu:
         F = k * (d - lu) + P[I_CZ] * factor * delta_rate_m_s
@@ -236,11 +289,21 @@ def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float,
         F = k * (d + lu) + P[I_CZ] * factor * delta_rate_m_s
     else:
         F = 0.0
+    T = P[I_MU] * abs(F) * friction_sign(p, P)  # |F|: dissipative on the back flank too
     dp = p - P[I_PITCH]
-    T = P[I_MU] * abs(F) if dp < 0.0 else -P[I_MU] * abs(F)  # |F|: dissipative on the back flank too
     rho1 = P[I_ARM1] + dp * P[I_PB]
     rho2 = P[I_ARM2] - dp * P[I_PB]
     return F, T, rho1, rho2
+
+
+@njit(cache=True)
+def friction_sign(p: float, P: np.ndarray) -> float:
+    """Direction of the friction force at mesh phase p: +1 before the pitch point, -1 after; with a
+    transition width, smooth steps at the pitch point and at the tooth change (0 there)."""
+    pitch, w = P[I_PITCH], P[I_WIDTH]
+    if w > 0.0 and 0.0 < pitch < 1.0:
+        return 2.0 * (smooth_step(p / w) - smooth_step((p - pitch) / w) + smooth_step((p - 1.0) / w)) - 1.0
+    return 1.0 if p < pitch else -1.0
 
 
 @njit(cache=True)
@@ -249,6 +312,16 @@ def torsional_mesh_forces(phi_p: float, phi_w: float, w_p: float, w_w: float, P:
     r1, r2 = P[I_R1], P[I_R2]
     F, T, rho1, rho2 = mesh_contact(phi_p, r1 * phi_p - r2 * phi_w, r1 * w_p - r2 * w_w, P)
     return -r1 * F + T * rho1, r2 * F - T * rho2
+
+
+@njit(cache=True)
+def single_mesh_drive_forces(
+    t: float, w_motor: float, phi_p: float, phi_w: float, w_p: float, w_w: float, P: np.ndarray, D: np.ndarray
+):
+    """Generalised forces of a torsional drive with one mesh, in one call (the solver's hot path):
+    motor torque, mesh moments on pinion and wheel (eq. 1), minus the load torque, N m."""
+    mp, mw = torsional_mesh_forces(phi_p, phi_w, w_p, w_w, P)
+    return motor_torque_at(t, w_motor, D), mp, mw, -load_torque_at(t, D)
 
 
 @njit(cache=True)
@@ -292,7 +365,10 @@ def mesh_gap_series(pinion_angle_rad: np.ndarray, delta_m: np.ndarray, P: np.nda
 
 def mesh_breakpoint_phases(P: np.ndarray) -> np.ndarray:
     """Mesh phases in [0, 1) where the force law jumps at fixed deflection: the tooth change (p = 0,
-    per-tooth stiffness factors), the single/double contact switches, the friction reversal, pit edges."""
+    per-tooth stiffness factors), the single/double contact switches, the friction reversal, pit edges.
+    None with a non-zero transition width: the law is then continuous in the phase."""
+    if P[I_WIDTH] > 0.0:
+        return np.zeros(0)
     phases = [0.0]
     if P[I_KIND] == PROFILE_CONTACT_RATIO and 0.0 < P[I_HALF_DOUBLE] < 0.5:
         phases += [P[I_HALF_DOUBLE], 1.0 - P[I_HALF_DOUBLE]]
