@@ -61,12 +61,18 @@ def test_a_pit_lowers_the_force_by_k_times_depth():
 @pytest.mark.parametrize(
     "override, needle",
     [
-        ('condition.pitted_teeth=[{gear="pinion",tooth=1,depth_um=1.0,start_phase=0.6,end_phase=0.5}]',
-         "end_phase"),
-        ('condition.pitted_teeth=[{gear="wheel",tooth=88,depth_um=1.0,start_phase=0.1,end_phase=0.5}]',
-         "tooth = 88"),
-        ('production.eccentricity=[{gear="wheel",amplitude_um=1.0},{gear="wheel",amplitude_um=2.0}]',
-         "one entry per gear"),
+        (
+            'condition.pitted_teeth=[{gear="pinion",tooth=1,depth_um=1.0,start_phase=0.6,end_phase=0.5}]',
+            "end_phase",
+        ),
+        (
+            'condition.pitted_teeth=[{gear="wheel",tooth=88,depth_um=1.0,start_phase=0.1,end_phase=0.5}]',
+            "tooth = 88",
+        ),
+        (
+            'production.eccentricity=[{gear="wheel",amplitude_um=1.0},{gear="wheel",amplitude_um=2.0}]',
+            "one entry per gear",
+        ),
         ('production.eccentricity=[{gear="shaft",amplitude_um=1.0}]', "gear"),
     ],
 )
@@ -76,8 +82,10 @@ def test_bad_fault_input_is_refused_by_name(override, needle):
 
 
 def test_a_missing_tooth_next_to_a_loaded_one_is_reported_not_hung():
-    """Stiffness factor 0 on one tooth: the lumped mesh chatters across that tooth's edge and Exudyn's
-    step control rejects steps forever; the watchdog in the motor user function reports it."""
+    """Stiffness factor 0 on one tooth: the lumped mesh has no load path for a whole mesh period. Either
+    the pinion chatters across that tooth's edge and Exudyn's step control rejects steps forever (the
+    watchdog reports a stall), or the pinion runs millimetres ahead through the wheel (the deflection
+    check reports it); never a silent result."""
     from gearbody.engine import SimulationError, simulate
 
     sc = load_scenario(
@@ -91,7 +99,7 @@ def test_a_missing_tooth_next_to_a_loaded_one_is_reported_not_hung():
             *QUIET,
         ],
     )
-    with pytest.raises(SimulationError, match=r"stalled at t = 0\.01"):
+    with pytest.raises(SimulationError, match=r"stalled at t = 0\.01|lumped mesh model is outside its range"):
         simulate(sc)
 
 

@@ -39,7 +39,12 @@ from ..model import Scenario
 from ..physics import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
 from ..physics.lateral import lateral_mesh_forces, tangent_stiffness_N_per_m
-from ..physics.mesh import mesh_contact, mesh_parameters_from_scenario, torsional_mesh_forces
+from ..physics.mesh import (
+    mesh_contact,
+    mesh_parameters_from_scenario,
+    single_mesh_drive_forces,
+    torsional_mesh_forces,
+)
 from ..physics.motor import pack_drive_parameters
 from .layout import Inertia, TorsionalLayout, reduced_mass_kg
 
@@ -159,6 +164,12 @@ def build_torsional(
         _add_bearings(built, layout, lateral_u0, modal)
     if modal:
         k_modal = np.broadcast_to(np.asarray(modal_mesh_stiffness_N_per_m, float), (len(layout.meshes),))
+    if not modal and not layout.is_lateral and layout.motor_at is not None and layout.load_at is not None:
+        _add_drive_and_meshes(built, layout)
+        if sensors:
+            _add_sensors(built)
+        mbs.Assemble()
+        return built
     for index, m in enumerate(layout.meshes):
         pair = [nodes[m.pinion], nodes[m.wheel]]
         bp, bw = layout.inertias[m.pinion], layout.inertias[m.wheel]
@@ -311,6 +322,52 @@ def build_muller(scenario: Scenario, q0, v0, *, sensors: bool = True) -> BuiltSy
     return built
 
 
+def _add_drive_and_meshes(built: BuiltSystem, layout: TorsionalLayout) -> None:
+    """Motor, load and all meshes of a torsional layout as ONE user-function item: one Python call per
+    right-hand-side evaluation instead of one per item (Exudyn's per-call overhead dominates the cost)."""
+    D = layout.drive
+    watchdog = _StallWatchdog()
+    if (
+        len(layout.meshes) == 1
+        and len({layout.motor_at, layout.meshes[0].pinion, layout.meshes[0].wheel, layout.load_at}) == 4
+    ):
+        m = layout.meshes[0]
+        order = [layout.motor_at, m.pinion, m.wheel, layout.load_at]
+        P = m.parameters
+
+        def drive_and_mesh(mbs, t, itemNumber, q, q_t):
+            watchdog(t)
+            return single_mesh_drive_forces(t, q_t[0], q[1], q[2], q_t[1], q_t[2], P, D)
+
+        function = drive_and_mesh
+    else:
+        order = list(range(len(layout.inertias)))
+        n, im, il = len(order), layout.motor_at, layout.load_at
+        meshes = [(m.pinion, m.wheel, m.parameters) for m in layout.meshes]
+
+        def drive_and_meshes(mbs, t, itemNumber, q, q_t):
+            watchdog(t)
+            f = [0.0] * n
+            f[im] = motor_torque_at(t, q_t[im], D)
+            f[il] -= load_torque_at(t, D)
+            for ip, iw, P in meshes:
+                a, b = torsional_mesh_forces(q[ip], q[iw], q_t[ip], q_t[iw], P)
+                f[ip] += a
+                f[iw] += b
+            return f
+
+        function = drive_and_meshes
+    built.user_functions.append(function)
+    built.mbs.AddObject(
+        ObjectGenericODE2(
+            nodeNumbers=[built.nodes[k] for k in order],
+            massMatrix=np.zeros((len(order), len(order))),
+            forceUserFunction=function,
+            visualization=HIDDEN,
+        )
+    )
+
+
 def _mesh_user_function(P: np.ndarray):
     def mesh_force(mbs, t, itemNumber, q, q_t):
         return torsional_mesh_forces(q[0], q[1], q_t[0], q_t[1], P)
@@ -356,31 +413,41 @@ STALL_CALLS = 200_000  # right-hand-side evaluations per check (~30k steps: ~0.1
 STALL_ADVANCE_S = 1e-9
 
 
-def _motor_user_function(D: np.ndarray):
-    """Motor torque; also the stall watchdog: Exudyn's step control can reject steps at the minimum step
-    size forever (no pre-step call happens then), but every attempt evaluates this function."""
-    state = {"calls": 0, "t_check": -1.0, "t_max": -1.0}
+class _StallWatchdog:
+    """Called with t on every force evaluation: Exudyn's step control can reject steps at the minimum step
+    size forever (no pre-step call happens then), but every attempt evaluates the drive's forces."""
 
-    def motor_torque(mbs, t, itemNumber, q, q_t):
-        state["calls"] += 1
-        if t > state["t_max"]:
-            state["t_max"] = t
-        if state["calls"] % STALL_CALLS == 0:
-            if state["t_max"] - state["t_check"] < STALL_ADVANCE_S:
+    def __init__(self) -> None:
+        self.calls, self.t_check, self.t_max = 0, -1.0, -1.0
+
+    def __call__(self, t: float) -> None:
+        self.calls += 1
+        if t > self.t_max:
+            self.t_max = t
+        if self.calls % STALL_CALLS == 0:
+            if self.t_max - self.t_check < STALL_ADVANCE_S:
                 raise StallError(
-                    f"the solver stalled at t = {state['t_max']:.9g} s: {STALL_CALLS} force evaluations "
+                    f"the solver stalled at t = {self.t_max:.9g} s: {STALL_CALLS} force evaluations "
                     f"advanced less than {STALL_ADVANCE_S:g} s (step size collapse at a discontinuity, "
                     "e.g. a tooth with stiffness factor 0 next to a loaded one). Hint: use a small "
                     "non-zero stiffness factor, or loosen solver.relative_tolerance / absolute_tolerance"
                 )
-            state["t_check"] = state["t_max"]
-        return [motor_torque_at(t, q_t[0], D)]
+            self.t_check = self.t_max
+
+
+def _motor_user_function(D: np.ndarray):
+    """Motor torque (and the stall watchdog)."""
+    watchdog = _StallWatchdog()
+
+    def motor_torque(mbs, t, itemNumber, q, q_t):
+        watchdog(t)
+        return (motor_torque_at(t, q_t[0], D),)
 
     return motor_torque
 
 
 def _load_user_function(D: np.ndarray):
     def load_torque(mbs, t, itemNumber, q, q_t):
-        return [-load_torque_at(t, D)]
+        return (-load_torque_at(t, D),)
 
     return load_torque

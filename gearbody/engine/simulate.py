@@ -185,12 +185,35 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
     if monitor.failure:
         raise SimulationError(monitor.failure)
     result = _collect(scenario, built)
+    _check_mesh_range(scenario, result)
     it = mbs.sys["dynamicSolver"].it
     result.meta["solver_statistics"]["rejected_steps"] = int(it.rejectedAutomaticStepSizeSteps)
     result.meta["solver_statistics"].update(
         {"build_wall_s": build_s, "solve_wall_s": solve_s, "wall_time_s": time.perf_counter() - wall0}
     )
     return result
+
+
+MAX_DEFLECTION_BASE_PITCH = 0.1
+"""Largest |mesh deflection| accepted, as a fraction of the base pitch: the lumped mesh (one pair of
+teeth in mesh, phase from the pinion angle) means nothing once the gears have moved that far apart."""
+
+
+def _check_mesh_range(scenario: Scenario, result: Result) -> None:
+    for k, st in enumerate(scenario.stages):
+        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        delta = np.abs(result[prefix + "mesh_deflection_m"])
+        p_b = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
+        if delta.max() > MAX_DEFLECTION_BASE_PITCH * p_b:
+            m = int(np.argmax(delta > MAX_DEFLECTION_BASE_PITCH * p_b))
+            raise SimulationError(
+                f"stage {k + 1}: the mesh deflection reached {delta[m] * 1e3:.3g} mm at t = "
+                f"{result.time_s[m]:.6g} s, more than {MAX_DEFLECTION_BASE_PITCH:g} of the base pitch "
+                f"({p_b * 1e3:.3g} mm): the lumped mesh model is outside its range (the gears ran "
+                "through each other). Hint: a tooth stiffness factor of 0 leaves no load path for a "
+                "whole mesh period in the lumped model; use a factor > 0 (e.g. 0.2), or check loads "
+                "and stiffnesses"
+            )
 
 
 def _stored(mbs, sensor_ids: list[int]) -> tuple[np.ndarray, np.ndarray]:
@@ -229,8 +252,9 @@ def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
 
     band_limit = scenario.solver.anti_aliasing and scenario.meta.scene != "muller"
     if band_limit:
-        t_fine = np.arange((n_out - 1) * OVERSAMPLING + 1) / (OVERSAMPLING * rate)
-        t = t_fine[::OVERSAMPLING]
+        M = _oversampling(scenario, built, v)
+        t_fine = np.arange((n_out - 1) * M + 1) / (M * rate)
+        t = t_fine[::M]
     else:
         t = np.arange(n_out) / rate
     signals: dict[str, np.ndarray] = {}
@@ -240,7 +264,7 @@ def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
     elif not band_limit:
         signals.update(_point_signals(scenario, built.dof_names, t, *states(t)))
     else:
-        signals.update(_band_limited_signals(scenario, built.dof_names, t_fine, *states(t_fine)))
+        signals.update(_band_limited_signals(scenario, built.dof_names, t_fine, *states(t_fine), M))
     stats = {
         "steps": n_steps,
         "method": scenario.solver.method,
@@ -280,11 +304,26 @@ def _point_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> dict[s
     return signals
 
 
-def _band_limited_signals(scenario, names, t_fine, q, v, a) -> dict[str, np.ndarray]:
-    """Signals on the output grid ``t_fine[::OVERSAMPLING]``: states and instantaneous mesh forces as
-    exact samples; accelerations, bearing and housing signals, and a ``mesh_force_bandlimited_N``
-    companion through the anti-aliasing filter with the mesh-law jumps treated exactly."""
+def _oversampling(scenario: Scenario, built: BuiltSystem, v_steps: np.ndarray) -> int:
+    """Fine points per output sample: OVERSAMPLING, or more so that every smoothed transition of the
+    mesh law (``transition_width`` w of a mesh period) spans at least 3 fine points at the fastest
+    mesh frequency of the run."""
     M = OVERSAMPLING
+    for k, st in enumerate(scenario.stages):
+        w = st.mesh.transition_width
+        if w > 0:
+            name = gear_names(k)[0]
+            row = built.dof_names.index(name)
+            f_mesh_hz = st.pinion.teeth * float(np.max(np.abs(v_steps[row]))) / (2 * math.pi)
+            M = max(M, math.ceil(3.0 * f_mesh_hz / (w * scenario.solver.output_rate_hz)))
+    return M
+
+
+def _band_limited_signals(scenario, names, t_fine, q, v, a, M=OVERSAMPLING) -> dict[str, np.ndarray]:
+    """Signals on the output grid ``t_fine[::M]``: states and instantaneous mesh forces as exact
+    samples; accelerations, bearing and housing signals, and a ``mesh_force_bandlimited_N`` companion
+    through the anti-aliasing filter with the mesh-law jumps treated exactly (smoothed transitions of
+    a non-zero transition width are resolved on the fine grid instead)."""
     fine = _point_signals(scenario, names, t_fine, q, v, a, drive_torques=False)
     t = t_fine[::M]
     jumps = []
