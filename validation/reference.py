@@ -40,6 +40,21 @@ events, outputs, contact re-classification).  The literal helpers :func:`runout_
 :func:`pit_error` and :func:`total_error` transcribe the same paragraph for the self-checks and the
 initial states.  Missing keys (older resolved scenarios) mean no fault.
 
+Transition width
+----------------
+With ``design.mesh.transition_width = w > 0`` (a stage's own mesh in a train; missing key: 0) every
+jump of the law at fixed deflection is spread over ``|p - p_jump| < w/2`` with the C2 smooth step
+``S`` (:func:`smooth_step`): contact-ratio stiffness ramps at h and 1 - h, the tooth factor and the
+whole error blended with the outgoing pair (at phase p + 1) for p < w/2 and with the incoming pair (at
+p - 1) for p > 1 - w/2 (the triangle extended by its straight lines, :func:`error_shape_ext`), smoothed
+pit edges and a smoothed friction sign (:func:`friction_sign`); the damping uses the blended factor.
+The literal transcription is :func:`blended_law` / :func:`mesh_force_literal` /
+:func:`friction_moments`.  For the segmented integration the break points become the ramp ends
+``p_jump -+ w/2`` (modulo 1), plus the kinks (p = 0 where the friction arms jump, the apex a, table
+points); inside each interval every smooth step is then 0, 1 or its quintic, and the locked mode
+carries that polynomial form (:class:`_SmoothMode`), so the right-hand side is again smooth within a
+segment.  With w = 0 nothing of this is used: the sharp code path is unchanged.
+
 The mesh force at the output times is evaluated from the (dense-output) states at those times with
 the very same function (``_mesh_force``) that the right-hand side uses, in the mode that was active
 when the sample time was reached.
@@ -86,6 +101,13 @@ __all__ = [
     "pitted_teeth",
     "pit_error",
     "total_error",
+    "smooth_step",
+    "transition_width",
+    "check_transition_width",
+    "error_shape_ext",
+    "pair_law",
+    "blended_law",
+    "friction_sign",
     "base_stiffness",
     "tooth_factors",
     "reduced_mass",
@@ -301,18 +323,29 @@ def pitted_teeth(scenario: dict) -> list[tuple[str, int, float, float, float]]:
 
 
 def pit_error(scenario: dict, p, i, j):
-    """Pitting error: - depth while the pitted tooth is in mesh (pinion tooth i, wheel tooth j) and
-    start_phase <= p < end_phase; pits on both teeth of a pair add."""
+    """Pitting error of the pair (pinion tooth i, wheel tooth j) at phase p: - depth while the pitted
+    tooth is in mesh and start_phase <= p < end_phase; pits on both teeth of a pair add.
+
+    With a transition width w > 0 the edges are smoothed, - depth [S((p - start)/w) - S((p - end)/w)]
+    (p may then lie outside [0, 1): the pair's pit function at the phase it is evaluated at).
+    """
     p = np.asarray(p, dtype=float)
+    w = transition_width(scenario["design"]["mesh"])
     E = np.zeros(np.broadcast(p, i, j).shape)
     for gear, tooth, depth, lo, hi in pitted_teeth(scenario):
         in_mesh = (np.asarray(i) if gear == "pinion" else np.asarray(j)) == tooth
-        E = E - np.where(in_mesh & (lo <= p) & (p < hi), depth, 0.0)
+        if w > 0.0:
+            E = E - np.where(in_mesh, depth * (smooth_step((p - lo) / w) - smooth_step((p - hi) / w)), 0.0)
+        else:
+            E = E - np.where(in_mesh & (lo <= p) & (p < hi), depth, 0.0)
     return E
 
 
 def total_error(scenario: dict, u):
-    """The whole error E at the mesh coordinate u: triangular shape (eq. 6) + run-out + pits."""
+    """The whole error E at the mesh coordinate u: triangular shape (eq. 6) + run-out + pits
+    (with w > 0 blended with the outgoing / incoming pair near the tooth change, :func:`blended_law`)."""
+    if transition_width(scenario["design"]["mesh"]) > 0.0:
+        return blended_law(scenario, u)[1]
     u = np.asarray(u, dtype=float)
     n = np.floor(u).astype(np.int64)
     p = u - n
@@ -323,14 +356,118 @@ def total_error(scenario: dict, u):
     return E + runout_error(scenario, u) + pit_error(scenario, p, i, j)
 
 
+# ----------------------------------------------------------------------------------------------
+# Transition width (docs/scenario.md, "Transition width"): literal transcription
+# ----------------------------------------------------------------------------------------------
+def smooth_step(x):
+    """C2 smooth step: S(x) = 0 for x <= -1/2, 1 for x >= 1/2, u^3 (10 - 15 u + 6 u^2), u = x + 1/2."""
+    u = np.clip(np.asarray(x, dtype=float) + 0.5, 0.0, 1.0)
+    return u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+
+
+def transition_width(mesh: dict) -> float:
+    """design.mesh.transition_width (a stage's mesh in a train); absent key: 0 (the sharp law)."""
+    w = float(mesh.get("transition_width", 0.0))
+    if not 0.0 <= w <= 0.1:
+        raise ValueError(f"transition_width must lie in [0, 0.1], got {w}")
+    return w
+
+
+def check_transition_width(scenario: dict) -> float:
+    """The transition width w of a one-stage-shaped scenario, with the limits of the spec checked:
+    w <= min(2h, 1 - 2h) (contact-ratio), w/2 <= pitch_point_phase <= 1 - w/2 (unless 0 or 1), every
+    pit at least w wide."""
+    mesh = scenario["design"]["mesh"]
+    w = transition_width(mesh)
+    if w == 0.0:
+        return w
+    tol = 1e-12
+    if mesh["stiffness_profile"] == "contact-ratio":
+        h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
+        if h > 0.0 and w > min(2.0 * h, 1.0 - 2.0 * h) + tol:
+            raise ValueError(f"transition_width {w} exceeds min(2h, 1 - 2h) = {min(2 * h, 1 - 2 * h)}")
+    ppp = float(mesh["pitch_point_phase"])
+    if 0.0 < ppp < 1.0 and not w / 2 - tol <= ppp <= 1.0 - w / 2 + tol:
+        raise ValueError(f"pitch_point_phase {ppp} must lie in [w/2, 1 - w/2] for transition_width {w}")
+    for gear, tooth, _depth, lo, hi in pitted_teeth(scenario):
+        if hi - lo < w - tol:
+            raise ValueError(f"pit on {gear} tooth {tooth} is narrower than transition_width {w}")
+    return w
+
+
+def error_shape_ext(q, a: float, e_i):
+    """Triangular shape extended by its straight lines outside [0, 1): the rising line e_i q / a where
+    it applies (q < a; for a = 1 also above 1), the falling line e_i (1 - q) / (1 - a) otherwise (q >= a;
+    for a = 0 also below 0).  Equal to :func:`error_shape` on [0, 1)."""
+    q = np.asarray(q, dtype=float)
+    e_i = np.asarray(e_i, dtype=float)
+    shape = np.broadcast(q, e_i).shape
+    rise = e_i * q / a if a > 0.0 else np.zeros(shape)
+    fall = e_i * (1.0 - q) / (1.0 - a) if a < 1.0 else np.zeros(shape)
+    use_rise = (q < a) & (a > 0.0) if a < 1.0 else np.ones(shape, dtype=bool)
+    return np.where(use_rise, rise, fall)
+
+
+def pair_law(scenario: dict, m, q):
+    """Tooth factor f_i g_j and error (triangle + pits, no run-out) of the pair of mesh period m
+    (i = m mod z1, j = m mod z2) evaluated at phase q (possibly outside [0, 1))."""
+    z1 = int(scenario["design"]["pinion"]["teeth"])
+    z2 = int(scenario["design"]["wheel"]["teeth"])
+    m = np.asarray(m, dtype=np.int64)
+    i, j = np.mod(m, z1), np.mod(m, z2)
+    f, g = tooth_factors(scenario)
+    a = float(scenario["production"]["error_mode"]["a"])
+    E = error_shape_ext(q, a, tooth_error_amplitudes(scenario)[i]) + pit_error(scenario, q, i, j)
+    return f[i] * g[j], E
+
+
+def blended_law(scenario: dict, u) -> tuple[np.ndarray, np.ndarray]:
+    """Tooth factor f g and whole error E at the mesh coordinate u, blended at the tooth change:
+    p < w/2: X = X_out + S(p/w) (X_in - X_out), outgoing pair (i - 1, j - 1) at phase p + 1;
+    p > 1 - w/2: X = X_in + S((p - 1)/w) (X_next - X_in), incoming pair (i + 1, j + 1) at p - 1.
+    The run-out (a function of u only) is the same for all pairs and is added once.
+    With w = 0: f_i g_j and the sharp E."""
+    u = np.asarray(u, dtype=float)
+    n = np.floor(u).astype(np.int64)
+    p = u - n
+    w = transition_width(scenario["design"]["mesh"])
+    fg_in, E_in = pair_law(scenario, n, p)
+    if w > 0.0:
+        fg_out, E_out = pair_law(scenario, n - 1, p + 1.0)
+        fg_nx, E_nx = pair_law(scenario, n + 1, p - 1.0)
+        s0, s1 = smooth_step(p / w), smooth_step((p - 1.0) / w)
+        low, high = p < w / 2, p > 1.0 - w / 2
+        fg_hi = np.where(high, fg_in + s1 * (fg_nx - fg_in), fg_in)
+        fg = np.where(low, fg_out + s0 * (fg_in - fg_out), fg_hi)
+        E = np.where(low, E_out + s0 * (E_in - E_out), np.where(high, E_in + s1 * (E_nx - E_in), E_in))
+    else:
+        fg, E = fg_in, E_in
+    return fg, E + runout_error(scenario, u)
+
+
+def friction_sign(p, pitch_point_phase: float, w: float = 0.0):
+    """s = +1 for p < pitch, -1 otherwise (w = 0); with w > 0 and 0 < pitch < 1:
+    s = 2 [S(p/w) - S((p - pitch)/w) + S((p - 1)/w)] - 1; pitch 0 or 1: constant sign."""
+    p = np.asarray(p, dtype=float)
+    ppp = float(pitch_point_phase)
+    if w > 0.0 and 0.0 < ppp < 1.0:
+        return 2.0 * (smooth_step(p / w) - smooth_step((p - ppp) / w) + smooth_step((p - 1.0) / w)) - 1.0
+    return np.where(p < ppp, 1.0, -1.0)
+
+
 def base_stiffness(p, mesh: dict):
     """k_z(p) without tooth factors ("contact-ratio" or "table")."""
     p = np.asarray(p, dtype=float)
     prof = mesh["stiffness_profile"]
     if prof == "contact-ratio":
         h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
-        double = (p < h) | (p >= 1.0 - h)
         k_double = float(mesh["stiffness_double_N_per_m"])
+        w = transition_width(mesh)
+        if w > 0.0:  # k_s + (k_d - k_s) [1 - S((p - h)/w) + S((p - 1 + h)/w)]
+            k_single = float(mesh["stiffness_single_N_per_m"])
+            ramp = 1.0 - smooth_step((p - h) / w) + smooth_step((p - 1.0 + h) / w)
+            return k_single + (k_double - k_single) * ramp
+        double = (p < h) | (p >= 1.0 - h)
         return np.where(double, k_double, float(mesh["stiffness_single_N_per_m"]))
     if prof == "table":
         ph = np.asarray(mesh["table_phase"], dtype=float)
@@ -381,17 +518,35 @@ def mesh_force_literal(scenario: dict, u, delta, delta_dot) -> dict:
     p = u - n
     i = np.mod(n, z1)
     j = np.mod(n, z2)
-    f, g = tooth_factors(scenario)
-    k = base_stiffness(p, mesh) * f[i] * g[j]
-    e_i = tooth_error_amplitudes(scenario)[i]
-    E = error_shape(p, float(scenario["production"]["error_mode"]["a"]), e_i)
-    E = E + runout_error(scenario, u) + pit_error(scenario, p, i, j)  # fault errors: in d only
+    if transition_width(mesh) > 0.0:  # blended tooth factor and error near the tooth change
+        fg, E = blended_law(scenario, u)
+        k = base_stiffness(p, mesh) * fg
+        Cf = float(mesh["damping_Ns_per_m"]) * fg  # the damping uses the blended factor
+    else:
+        f, g = tooth_factors(scenario)
+        fg = f[i] * g[j]
+        k = base_stiffness(p, mesh) * f[i] * g[j]
+        e_i = tooth_error_amplitudes(scenario)[i]
+        E = error_shape(p, float(scenario["production"]["error_mode"]["a"]), e_i)
+        E = E + runout_error(scenario, u) + pit_error(scenario, p, i, j)  # fault errors: in d only
+        Cf = float(mesh["damping_Ns_per_m"]) * f[i] * g[j]
     d = np.asarray(delta, dtype=float) + E
     lu = float(mesh["backlash_um"]) * 1e-6
     F_el = k * np.maximum(d - lu, np.minimum(d + lu, 0.0))
     contact = np.abs(d) > lu
-    F_t = np.where(contact, float(mesh["damping_Ns_per_m"]) * f[i] * g[j] * np.asarray(delta_dot, float), 0.0)
-    return {"F": F_el + F_t, "F_el": F_el, "F_t": F_t, "p": p, "i": i, "j": j, "k": k, "E": E, "d": d}
+    F_t = np.where(contact, Cf * np.asarray(delta_dot, float), 0.0)
+    return {
+        "F": F_el + F_t,
+        "F_el": F_el,
+        "F_t": F_t,
+        "p": p,
+        "i": i,
+        "j": j,
+        "k": k,
+        "E": E,
+        "d": d,
+        "fg": fg,
+    }
 
 
 def friction_moments(scenario: dict, p, F) -> dict:
@@ -404,7 +559,7 @@ def friction_moments(scenario: dict, p, F) -> dict:
     tan_a = math.tan(math.radians(float(mesh["pressure_angle_deg"])))
     pb = TWO_PI * r1 / z1
     p = np.asarray(p, dtype=float)
-    s = np.where(p < ppp, 1.0, -1.0)
+    s = friction_sign(p, ppp, transition_width(mesh))
     T = float(scenario["condition"]["friction_coefficient"]) * np.abs(np.asarray(F, dtype=float)) * s
     rho1 = r1 * tan_a + (p - ppp) * pb
     rho2 = r2 * tan_a - (p - ppp) * pb
@@ -433,7 +588,10 @@ def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     F0 = M_L / r2
     M_p = F0 * r1
     f, g = tooth_factors(scenario)
-    k0 = float(base_stiffness(0.0, mesh)) * f[0] * g[0]
+    if transition_width(mesh) > 0.0:  # the law at u = 0: factor blended with the outgoing pair
+        k0 = float(base_stiffness(0.0, mesh)) * float(blended_law(scenario, 0.0)[0])
+    else:
+        k0 = float(base_stiffness(0.0, mesh)) * f[0] * g[0]
     E0 = float(total_error(scenario, 0.0))  # total error at p = 0, tooth 0 (fault errors included)
     delta0 = F0 / k0 + lu - E0 if F0 != 0.0 else 0.0
     if scene == "muller":
@@ -497,7 +655,10 @@ def _train_initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
         p = u - n
         i, j = n % z_p[s], n % z_w[s]
         f, g = tooth_factors(view)
-        k = float(base_stiffness(p, mesh)) * f[i] * g[j]
+        if transition_width(mesh) > 0.0:  # the law at u: factor blended near the tooth change
+            k = float(base_stiffness(p, mesh)) * float(blended_law(view, u)[0])
+        else:
+            k = float(base_stiffness(p, mesh)) * f[i] * g[j]
         E = float(total_error(view, u))  # fault errors included
         lu = float(mesh["backlash_um"]) * 1e-6
         if F[s] == 0.0:
@@ -519,6 +680,9 @@ def _train_initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
 def phase_breakpoints(scenario: dict) -> np.ndarray:
     """All phases in [0, 1) at which some mesh quantity jumps or kinks (0 always included)."""
     mesh = scenario["design"]["mesh"]
+    w = check_transition_width(scenario)
+    if w > 0.0:
+        return _phase_breakpoints_smooth(scenario, w)
     pts = [0.0]
     if mesh["stiffness_profile"] == "contact-ratio":
         h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
@@ -533,6 +697,37 @@ def phase_breakpoints(scenario: dict) -> np.ndarray:
     pts = np.unique([x for x in pts if 0.0 <= x < 1.0])
     # merge points closer than 1e-9 (e.g. a pit edge 0.3 and h = 0.30000000000000004): no degenerate
     # intervals narrower than the event hysteresis
+    keep = [pts[0]]
+    for x in pts[1:]:
+        if x - keep[-1] > 1e-9 and 1.0 - x > 1e-9:
+            keep.append(x)
+    return np.array(keep)
+
+
+def _phase_breakpoints_smooth(scenario: dict, w: float) -> np.ndarray:
+    """Break points with a transition width w > 0: each smoothed jump at p_c becomes a C2 ramp on
+    [p_c - w/2, p_c + w/2] whose ends (where the third derivative jumps) are break points, taken
+    modulo 1 (the ramps of the tooth change, 0 -+ w/2, and of anything near it straddle a period
+    end).  Kinks stay break points: p = 0 (the friction arms jump there while s passes 0), the error
+    apex a and the table points.  The centres of the ramps are not needed (the law is a polynomial
+    across them), so that inside every interval each smooth step is locked at 0, 1 or its polynomial.
+    """
+    mesh = scenario["design"]["mesh"]
+    centres = [0.0]  # tooth change
+    kinks = [0.0, float(scenario["production"]["error_mode"]["a"]) % 1.0]
+    if mesh["stiffness_profile"] == "contact-ratio":
+        h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
+        centres += [h, 1.0 - h]
+    else:
+        kinks += [float(x) % 1.0 for x in mesh["table_phase"]]
+    ppp = float(mesh["pitch_point_phase"])
+    if scenario["meta"]["scene"] != "muller" and float(scenario["condition"]["friction_coefficient"]) != 0.0:
+        if 0.0 < ppp < 1.0:
+            centres.append(ppp)
+    for _gear, _tooth, _depth, lo, hi in pitted_teeth(scenario):
+        centres += [lo, hi]
+    pts = kinks + [(c + sgn * 0.5 * w) % 1.0 for c in centres for sgn in (-1.0, 1.0)]
+    pts = np.unique([x for x in pts if 0.0 <= x < 1.0])
     keep = [pts[0]]
     for x in pts[1:]:
         if x - keep[-1] > 1e-9 and 1.0 - x > 1e-9:
@@ -559,11 +754,15 @@ class _ModeConsts(NamedTuple):
     pit: float  # depth of the pits active on this interval (constant there: pit edges are breakpoints)
     nf: float  # n, so that u = n + p
     runout: tuple  # (A, 2 pi / z, theta) per run-out term: A sin(2 pi u / z + theta)
+    tw: _SmoothMode | None = None  # transition width w > 0: the smoothed law of this mode (else None)
 
 
 def _mode_error(mc: _ModeConsts, p):
     """Total error E in a locked mode at p = u - n (float or array): triangle - pit + run-out."""
-    E = mc.e_i * (mc.Ea + mc.Eb * p) - mc.pit
+    if mc.tw is not None:
+        E = _smooth_error(mc.tw, p)
+    else:
+        E = mc.e_i * (mc.Ea + mc.Eb * p) - mc.pit
     if mc.runout:
         u = mc.nf + p
         sin = math.sin if isinstance(u, float) else np.sin
@@ -580,7 +779,77 @@ def _mesh_force(mc: _ModeConsts, p, delta, delta_dot):
     if mc.c == 0:
         return 0.0 * (p + delta + delta_dot)
     d = delta + _mode_error(mc, p)
+    tw = mc.tw
+    if tw is not None:  # blended factor (also in the damping) and smoothed stiffness
+        fg = _smooth_factor(tw, p)
+        return fg * (_poly_eval(tw.kz, p) * (d - mc.c * mc.lu) + tw.Cz * delta_dot)
     return mc.fg * (mc.kA + mc.kS * (p - mc.bA)) * (d - mc.c * mc.lu) + mc.Cf * delta_dot
+
+
+def _mode_mu_sign(mesh: _Mesh, k: int, mc: _ModeConsts, p):
+    """mu s in a locked mode at p (float or array): the interval's constant with w = 0, the smoothed
+    friction sign of :func:`friction_sign` with w > 0."""
+    if mc.tw is None:
+        return mesh.mu * mesh.iv[k][4] + 0.0 * p
+    return _poly_eval(mc.tw.mus, p)
+
+
+# ----------------------------------------------------------------------------------------------
+# Locked-mode form of the smoothed law (transition width w > 0)
+# ----------------------------------------------------------------------------------------------
+# Inside one phase interval every smooth step S((q - c)/w) is either 0, 1 or its quintic (all ramp
+# ends are break points), so each smoothed quantity is  A + B p + sum coef * P((p - c) / w + 1/2)
+# with P(x) = x^3 (10 - 15 x + 6 x^2): stored as (A, B, ((coef, c, 1/w), ...)).  Evaluated with
+# the quintic also slightly beyond the interval ends (trial steps), so the right-hand side is smooth.
+class _SmoothMode(NamedTuple):
+    kz: tuple  # k_z(p) (tables: the linear piece)
+    mus: tuple  # mu s(p)
+    beta: tuple | None  # blend weight S(p/w) or S((p - 1)/w); None: a single pair (no blending)
+    fgA: float  # factor of pair A (outgoing / in mesh)
+    fgB: float  # factor of pair B (in mesh / incoming); X = X_A + beta (X_B - X_A)
+    EA: tuple  # error of pair A (triangle + pits; run-out is added by _mode_error)
+    EB: tuple
+    Cz: float  # mesh damping C_z (times the blended factor)
+
+
+def _poly_eval(L: tuple, p):
+    A, B, terms = L
+    v = A + B * p
+    for coef, c, iw in terms:
+        x = (p - c) * iw + 0.5
+        v = v + coef * (x * x * x * (10.0 - 15.0 * x + 6.0 * x * x))
+    return v
+
+
+def _smooth_factor(tw: _SmoothMode, p):
+    if tw.beta is None:
+        return tw.fgA + 0.0 * p
+    return tw.fgA + _poly_eval(tw.beta, p) * (tw.fgB - tw.fgA)
+
+
+def _smooth_error(tw: _SmoothMode, p):
+    EA = _poly_eval(tw.EA, p)
+    if tw.beta is None:
+        return EA
+    return EA + _poly_eval(tw.beta, p) * (_poly_eval(tw.EB, p) - EA)
+
+
+class _PolyBuilder:
+    """Accumulates A + B p + sum coef S((p - c)/w) on one phase interval (midpoint ``mid``)."""
+
+    def __init__(self, w: float, mid: float, A: float = 0.0, B: float = 0.0):
+        self.w, self.mid, self.A, self.B, self.terms = w, mid, A, B, []
+
+    def step(self, coef: float, c: float) -> None:
+        """Add coef S((p - c)/w), locked on the interval: 0, coef, or the quintic."""
+        x = (self.mid - c) / self.w
+        if x >= 0.5:
+            self.A += coef
+        elif x > -0.5:
+            self.terms.append((coef, c, 1.0 / self.w))
+
+    def done(self) -> tuple:
+        return (self.A, self.B, tuple(self.terms))
 
 
 class _Mesh:
@@ -611,6 +880,8 @@ class _Mesh:
         self.runout = tuple((amp, TWO_PI / z, theta) for amp, theta, z in runout_terms(sc))
         self.pits = pitted_teeth(sc)
         self.Frated = F_rated(sc) if Frated is None else float(Frated)
+        self.w = check_transition_width(sc)
+        self.mesh = mesh
         # phase intervals
         b = phase_breakpoints(sc)
         self.bA = b
@@ -638,6 +909,68 @@ class _Mesh:
         self.omega_n = math.sqrt(kmax / self.m_red)
 
     # -- mode constants ---------------------------------------------------------------------
+    def smooth_mode(self, n: int, k: int) -> _SmoothMode:
+        """The smoothed law (w > 0) on phase interval k of mesh period n, in locked form."""
+        w = self.w
+        lo, hi = float(self.bA[k]), float(self.bB[k])
+        mid = 0.5 * (lo + hi)
+        mesh = self.mesh
+        # stiffness k_z = k_s + (k_d - k_s) [1 - S((p - h)/w) + S((p - 1 + h)/w)]; tables unchanged
+        if mesh["stiffness_profile"] == "contact-ratio":
+            h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
+            ks, kd = float(mesh["stiffness_single_N_per_m"]), float(mesh["stiffness_double_N_per_m"])
+            kz = _PolyBuilder(w, mid, A=kd)
+            kz.step(-(kd - ks), h)
+            kz.step(kd - ks, 1.0 - h)
+        else:
+            kA, kS = self.iv[k][0], self.iv[k][1]
+            kz = _PolyBuilder(w, mid, A=kA - kS * lo, B=kS)
+        # friction: mu s, s = 2 [S(p/w) - S((p - pitch)/w) + S((p - 1)/w)] - 1 (0 < pitch < 1)
+        if 0.0 < self.ppp < 1.0:
+            mus = _PolyBuilder(w, mid, A=-self.mu)
+            mus.step(2.0 * self.mu, 0.0)
+            mus.step(-2.0 * self.mu, self.ppp)
+            mus.step(2.0 * self.mu, 1.0)
+        else:
+            mus = _PolyBuilder(w, mid, A=self.mu * (1.0 if mid < self.ppp else -1.0))
+        # pairs near the tooth change: (period, phase shift q - p)
+        if mid < 0.5 * w:
+            pairs, beta = [(n - 1, 1.0), (n, 0.0)], _PolyBuilder(w, mid)
+            beta.step(1.0, 0.0)
+        elif mid > 1.0 - 0.5 * w:
+            pairs, beta = [(n, 0.0), (n + 1, -1.0)], _PolyBuilder(w, mid)
+            beta.step(1.0, 1.0)
+        else:
+            pairs, beta = [(n, 0.0)], None
+        fgs, Es = [], []
+        a = self.a
+        for m, shift in pairs:
+            i, j = m % self.z1, m % self.z2
+            fgs.append(self.f[i] * self.g[j])
+            e_i = float(self.e_amp[i])
+            qmid = mid + shift
+            # triangle extended by its straight lines, as a function of p (q = p + shift)
+            if a >= 1.0 or (a > 0.0 and qmid < a):
+                E = _PolyBuilder(w, qmid, A=e_i * shift / a, B=e_i / a)
+            else:
+                E = _PolyBuilder(w, qmid, A=e_i * (1.0 - shift) / (1.0 - a), B=-e_i / (1.0 - a))
+            for gear, tooth, depth, plo, phi in self.pits:  # - depth [S((q - start)/w) - S((q - end)/w)]
+                if tooth == (i if gear == "pinion" else j):
+                    E.step(-depth, plo)
+                    E.step(depth, phi)
+            # centres in q -> centres in p
+            Es.append((E.A, E.B, tuple((cf, c - shift, iw) for cf, c, iw in E.terms)))
+        return _SmoothMode(
+            kz=kz.done(),
+            mus=mus.done(),
+            beta=beta.done() if beta is not None else None,
+            fgA=fgs[0],
+            fgB=fgs[-1],
+            EA=Es[0],
+            EB=Es[-1],
+            Cz=self.Cz,
+        )
+
     def mode_consts(self, n: int, k: int, c: int) -> _ModeConsts:
         kA, kS, Ea, Eb, _s = self.iv[k]
         i, j = n % self.z1, n % self.z2
@@ -661,6 +994,7 @@ class _Mesh:
             pit=pit,
             nf=float(n),
             runout=self.runout,
+            tw=self.smooth_mode(n, k) if self.w > 0.0 else None,
         )
 
     def phase_mode(self, u: float, u_dot: float) -> tuple[int, int]:
@@ -758,6 +1092,8 @@ class _Model(_Mesh):
         mesh = _mesh_force
         nf = float(n)
         array = np.array
+        mus_poly = mc.tw.mus if mc.tw is not None else None  # w > 0: mu s(p)
+        peval = _poly_eval
 
         if self.scene == "muller":
             m = self.m_red
@@ -782,7 +1118,7 @@ class _Model(_Mesh):
                 tau = t - ta
                 p = p1 * cz - nf
                 F = mesh(mc, p, r1 * p1 - r2 * p2, r1 * w1 - r2 * w2)
-                T = mus * abs(F)
+                T = (mus if mus_poly is None else peval(mus_poly, p)) * abs(F)
                 q = (p - ppp) * pb
                 slip = (wsr * (sa + ss * tau) - w1) / wsr
                 Ms = 2.0 * Mb * sb * slip / (slip * slip + sbsq)
@@ -801,7 +1137,7 @@ class _Model(_Mesh):
             tau = t - ta
             p = p2 * cz - nf
             F = mesh(mc, p, r1 * p2 - r2 * p3, r1 * w2 - r2 * w3)
-            T = mus * abs(F)
+            T = (mus if mus_poly is None else peval(mus_poly, p)) * abs(F)
             q = (p - ppp) * pb
             slip = (wsr * (sa + ss * tau) - w1) / wsr
             Ms = 2.0 * Mb * sb * slip / (slip * slip + sbsq)
@@ -1007,7 +1343,7 @@ class _Train:
                     m.cz,
                     float(n),
                     mc,
-                    m.mu * m.iv[k][4],
+                    m.mu * m.iv[k][4] if mc.tw is None else mc.tw.mus,
                     m.ppp,
                     m.pb,
                     m.r1 * m.tan_a,
@@ -1024,6 +1360,7 @@ class _Train:
         Ip = self.inertia[1:-1:2]
         Iw = self.inertia[2:-1:2]
         mesh = _mesh_force
+        peval = _poly_eval
         array = np.array
 
         def rhs(t, y):
@@ -1039,7 +1376,7 @@ class _Train:
             for s, (ip, iw, r1, r2, cz, nf, mc, mus, ppp, pb, r1tan, r2tan) in enumerate(stage_data):
                 p = q[ip] * cz - nf
                 F = mesh(mc, p, r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw])
-                T = mus * abs(F)
+                T = (mus if mc.tw is None else peval(mus, p)) * abs(F)
                 qq = (p - ppp) * pb
                 # I_ps phi_ps'' = S_{s-1} - r_ps F_s + M_zt1,s;  I_ws phi_ws'' = r_ws F_s - M_zt2,s - S_s
                 acc.append((S[s] - r1 * F + T * (r1tan + qq)) / Ip[s])

@@ -21,6 +21,10 @@ pinion: moment ``-r1 F + T rho_1``, force ``-F n + T m``; wheel: ``+r2 F - T rho
 Fault errors (run-out, pits) are part of the error E and enter ``d = delta + E`` only, exactly as in
 the torsional reference (its locked-mode constants and ``_mode_error``; the initial deflection uses
 ``total_error``); the lateral projection is part of ``delta`` and so sits beside them in ``d``.
+The transition width (``mesh.transition_width`` w > 0: smoothed stiffness ramps, blended factor and
+error at the tooth change, smoothed pit edges and friction sign) comes with the torsional reference's
+locked-mode law as well; only the friction sign, a constant of the mode when w = 0, is here evaluated
+from the mode's polynomial form (``_poly_eval`` / ``_mode_mu_sign``).
 Bearing forces: linear ``-(k_x x + C_x x', k_y y + C_y y')``; hertzian
 ``-max(k_b (r - c)^n + C u'.u / r, 0) u / r`` for ``r > c``, else 0.
 
@@ -379,7 +383,7 @@ class _LatTrain:
                     m.cz,
                     float(n),
                     mc,
-                    m.mu * m.iv[k][4],
+                    m.mu * m.iv[k][4] if mc.tw is None else mc.tw.mus,  # w > 0: mu s(p) in locked form
                     m.ppp,
                     m.pb,
                     m.r1 * m.tan_a,
@@ -413,6 +417,7 @@ class _LatTrain:
         Ip = self.inertia[1:-1:2]
         Iw = self.inertia[2:-1:2]
         mesh = ref._mesh_force
+        peval = ref._poly_eval
         array = np.array
         sqrt = math.sqrt
 
@@ -436,7 +441,7 @@ class _LatTrain:
                     ddot += c * v[i]
                 p = q[ip] * cz - nf
                 F = mesh(mc, p, delta, ddot)
-                T = mus * abs(F)
+                T = (mus if mc.tw is None else peval(mus, p)) * abs(F)
                 qq = (p - ppp) * pb
                 acc.append((S[s] - r1 * F + T * (r1tan + qq)) / Ip[s])
                 acc.append((r2 * F - T * (r2tan - qq) - S[s + 1]) / Iw[s])
@@ -547,7 +552,10 @@ class _LatTrain:
             u, delta, ddot = self.kin(s, ys)
             F[s] = ref._mesh_force(mcs[s], u - modes[s][0], delta, ddot)
             m = self.meshes[s]
-            T[s] = m.mu * m.iv[modes[s][1]][4] * np.abs(F[s])
+            if mcs[s].tw is None:
+                T[s] = m.mu * m.iv[modes[s][1]][4] * np.abs(F[s])
+            else:  # transition width w > 0: smoothed friction sign
+                T[s] = ref._mode_mu_sign(m, modes[s][1], mcs[s], u - modes[s][0]) * np.abs(F[s])
             nvec, mvec = self.geo[s]["n"], self.geo[s]["m"]
             gp, gw = self.stage_gears[s]
             if gp is not None:
@@ -622,7 +630,10 @@ def initial_state_lateral(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
         p = u - n
         i, j = n % z_p[s], n % z_w[s]
         f, g = ref.tooth_factors(view)
-        k = float(ref.base_stiffness(p, mesh)) * f[i] * g[j]
+        if ref.transition_width(mesh) > 0.0:  # the law at u: factor blended near the tooth change
+            k = float(ref.base_stiffness(p, mesh)) * float(ref.blended_law(view, u)[0])
+        else:
+            k = float(ref.base_stiffness(p, mesh)) * f[i] * g[j]
         E = float(ref.total_error(view, u))  # fault errors included
         lu = float(mesh["backlash_um"]) * 1e-6
         if F[s] == 0.0:

@@ -197,7 +197,7 @@ def tooth_pair_factor(i: int, j: int, P: np.ndarray) -> float:
 @njit(cache=True)
 def error_shape(p: float, a: float) -> float:
     """Triangular error shape of Fig. 4 (b, c): 0 at p = 0 and 1, maximum 1 at p = a."""
-    if a > 0.0 and p < a:  # (p outside [0, 1) extends the straight lines: regularised tooth change)
+    if a > 0.0 and (p < a or a >= 1.0):  # outside [0, 1): the straight lines extended (regularised)
         return p / a
     return (1.0 - p) / (1.0 - a) if a < 1.0 else 1.0
 
