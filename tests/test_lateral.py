@@ -198,7 +198,8 @@ def test_a_user_bearing_law_runs_without_touching_the_engine():
 
     register_bearing("isotropic-test", Isotropic)
     try:
-        base = load_scenario("lateral-8dof", [*STEADY, "operation.t_end_s=0.01"])
+        tight = ["solver.relative_tolerance=1e-13", "solver.absolute_tolerance=1e-12"]  # same law, 1e-6
+        base = load_scenario("lateral-8dof", [*STEADY, "operation.t_end_s=0.01", *tight])
         data = scenario_to_dict(base)
         for gear in ("pinion", "wheel"):
             b = data["design"][gear]["bearing"]
