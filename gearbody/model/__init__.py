@@ -21,6 +21,7 @@ from .scenario import (
     Shaft,
     Solver,
     Stage,
+    Visual,
 )
 
 __all__ = [
@@ -43,6 +44,7 @@ __all__ = [
     "Shaft",
     "Stage",
     "Solver",
+    "Visual",
     "dump_scenario",
     "load_scenario",
     "parse_override",

@@ -90,6 +90,9 @@ class Gear:
     mass_kg: float = param(gt=0, doc="mass (lateral models)")
     lateral: str = param("none", choices=LATERAL, doc="free translations of the gear centre")
     bearing: Bearing | None = param(None, doc="bearing to the housing (required when lateral)")
+    face_width_m: float | None = param(
+        None, gt=0, le=2, doc="face width b (pictures; unset: 10 modules)"
+    )
 
     def __post_init__(self) -> None:
         if self.lateral != "none" and self.bearing is None:
@@ -319,6 +322,16 @@ class Solver:
 
 
 @dataclass(frozen=True, kw_only=True)
+class Visual:
+    """How pictures of the machine look (gearbody render); no effect on the simulation."""
+
+    housing: bool = param(False, doc="draw a transparent gear housing")
+    lateral_scale: float = param(
+        1000.0, ge=0, le=1e6, doc="magnification of the gears' lateral motion in pictures (0: none)"
+    )
+
+
+@dataclass(frozen=True, kw_only=True)
 class Scenario:
     meta: Meta
     design: Design
@@ -326,6 +339,7 @@ class Scenario:
     operation: Operation
     condition: Condition = param(default_factory=Condition)
     solver: Solver = param(default_factory=Solver)
+    visual: Visual = param(default_factory=Visual)
 
     def __post_init__(self) -> None:
         d = self.design
@@ -401,6 +415,23 @@ class Scenario:
             if len(set(gears)) < len(gears):
                 where_e = f"design.stages[{k}]." if train else "production."
                 raise ScenarioError(f"{where_e}eccentricity: at most one entry per gear, got {gears}")
+        if self.meta.scene == "train":
+            # A stage's pinion turns with the previous stage's wheel, so the direction of its line of
+            # action is fixed by the chain; on bearings (lateral) a contradicting direction would put
+            # the mesh and friction forces on the wrong side of the gears.
+            sense = 1 if self.stages[0].mesh.line_of_action_normal_projection > 0 else -1
+            for k, st in enumerate(self.stages):
+                own = 1 if st.mesh.line_of_action_normal_projection > 0 else -1
+                lateral = st.pinion.lateral != "none" or st.wheel.lateral != "none"
+                if k > 0 and lateral and own != sense:
+                    turn = "counter-clockwise" if sense > 0 else "clockwise"
+                    raise ScenarioError(
+                        f"design.stages[{k}].mesh.line_of_action_deg = {st.mesh.line_of_action_deg:g}: this "
+                        f"stage's pinion turns {turn} (with the previous wheel), so its line of action must "
+                        f"point the other way: centre_line_deg {'+' if sense > 0 else '-'} (90 - pressure "
+                        f"angle), e.g. {st.mesh.centre_line_deg + sense * 90:g} for a pure normal"
+                    )
+                sense = -sense
         if self.meta.scene in ("muller", "two-wheel"):
             for name in ("pinion", "wheel"):
                 if getattr(d, name).lateral != "none":
