@@ -1,0 +1,182 @@
+"""3D pictures and animations of a drive, laid out from the scenario and moved by a Result.
+
+``render(scenario, result, out_dir=...)`` writes PNG frames and an animated GIF (MP4 with ffmpeg)
+without a display, using Exudyn's software raytracer; ``view(scenario, result)`` replays the result
+in Exudyn's interactive viewer. See docs/render.md.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..model import Scenario
+from ..result import Result
+from .layout import Layout, build_layout
+from .movie import FORMATS, ffmpeg_available, write_gif, write_mp4, write_png
+from .poses import RenderError, body_poses, frame_times, kinematic_result
+from .scene3d import VIEWS, RenderOptions, has_display
+
+__all__ = [
+    "FORMATS",
+    "VIEWS",
+    "Layout",
+    "RenderError",
+    "RenderOptions",
+    "RenderOutput",
+    "build_layout",
+    "check_result_matches",
+    "kinematic_result",
+    "render",
+    "render_images",
+    "view",
+]
+
+
+@dataclass
+class RenderOutput:
+    frames: list[Path] = field(default_factory=list)
+    times_s: np.ndarray | None = None
+    movie: Path | None = None
+    build_s: float = 0.0
+    render_s: float = 0.0
+
+
+def check_result_matches(scenario: Scenario, result: Result) -> None:
+    """Refuse a result simulated from a different drive (other teeth counts or stage count)."""
+    saved = result.meta.get("scenario") if isinstance(result.meta, dict) else None
+    if not isinstance(saved, dict):
+        return
+    design = saved.get("design", {})
+    stages = design.get("stages") or [{"pinion": design.get("pinion", {}), "wheel": design.get("wheel", {})}]
+    ours = [(st.pinion.teeth, st.wheel.teeth) for st in scenario.stages]
+    theirs = [(st.get("pinion", {}).get("teeth"), st.get("wheel", {}).get("teeth")) for st in stages]
+    if theirs != ours:
+        raise RenderError(
+            f"result: simulated for teeth {theirs}, but the scene has {ours}; render the result with its "
+            "own scenario (DIR/scenario.toml)"
+        )
+
+
+def render_images(
+    scenario: Scenario,
+    result: Result | None,
+    times_s: np.ndarray,
+    options: RenderOptions | None = None,
+    lateral_scale: float | None = None,
+    lateral_about_mean: bool = True,
+):
+    """Yield (time, RGB image) for each time: the drive in the result's pose, raytraced (no result:
+    rigid rotation at the synchronous speed)."""
+    from .scene3d import VisualSystem
+
+    layout = build_layout(scenario)
+    if result is None:
+        speed = scenario.design.motor.synchronous_speed_rad_s
+        result = kinematic_result(layout, speed, max(2 * np.pi / speed, float(np.max(times_s))))
+    check_result_matches(scenario, result)
+    poses = body_poses(layout, result, np.asarray(times_s, dtype=float), lateral_scale, lateral_about_mean)
+    system = VisualSystem(layout, options)
+    system.set_camera()
+    for t, row in zip(times_s, poses, strict=True):
+        system.set_pose(row, t)
+        yield float(t), system.image()
+
+
+def render(
+    scenario: Scenario,
+    result: Result | None = None,
+    *,
+    out_dir: str | Path,
+    frames: int = 24,
+    start_s: float | None = None,
+    end_s: float | None = None,
+    options: RenderOptions | None = None,
+    lateral_scale: float | None = None,
+    lateral_about_mean: bool = True,
+    movie: str = "gif",
+    fps: float = 20.0,
+    progress: bool = False,
+) -> RenderOutput:
+    """Render ``frames`` pictures of the drive moving as in ``result`` into ``out_dir``.
+
+    Writes ``frame_0000.png`` ... and ``animation.gif`` (``movie='gif'``) or ``animation.mp4``
+    (``movie='mp4'``, needs ffmpeg), or no movie (``'none'``). Without a result, the drive turns
+    rigidly at its synchronous speed (no simulation). Lateral gear motion is magnified by
+    ``lateral_scale`` (default: the scenario's ``visual.lateral_scale``), about its mean over the
+    frames unless ``lateral_about_mean`` is False (then the static deflection is magnified too).
+    """
+    if movie not in FORMATS:
+        raise RenderError(f"movie = {movie!r}: must be one of {', '.join(FORMATS)}")
+    if not 0.1 <= fps <= 120:
+        raise RenderError(f"fps = {fps:g}: must lie in [0.1, 120]")
+    if movie == "mp4" and not ffmpeg_available():
+        raise RenderError("movie = 'mp4': ffmpeg is not installed (use 'gif', or install ffmpeg)")
+    if lateral_scale is not None and not 0 <= lateral_scale <= 1e6:
+        raise RenderError(f"lateral_scale = {lateral_scale:g}: must lie in [0, 1e6]")
+    options = options or RenderOptions()
+    options.check()
+    layout = build_layout(scenario)
+    if result is None:
+        speed = scenario.design.motor.synchronous_speed_rad_s
+        result = kinematic_result(layout, speed, 2 * np.pi / speed)
+    check_result_matches(scenario, result)
+    times = frame_times(result, frames, start_s, end_s)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    for old in [*out.glob("frame_*.png"), out / "animation.gif", out / "animation.mp4"]:
+        old.unlink(missing_ok=True)
+    output = RenderOutput(times_s=times)
+    t0 = time.perf_counter()
+    images = render_images(scenario, result, times, options, lateral_scale, lateral_about_mean)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(times), unit="frame", desc="render")
+    first = True
+    for k, (_, image) in enumerate(images):
+        if first:
+            output.build_s = time.perf_counter() - t0
+            t1, first = time.perf_counter(), False
+        output.frames.append(write_png(image, out / f"frame_{k:04d}.png"))
+        if bar is not None:
+            bar.update()
+    if bar is not None:
+        bar.close()
+    output.render_s = time.perf_counter() - t1
+    if movie == "gif" and len(output.frames) > 1:
+        output.movie = write_gif(output.frames, out / "animation.gif", fps)
+    elif movie == "mp4" and len(output.frames) > 1:
+        output.movie = write_mp4(out / "frame_%04d.png", out / "animation.mp4", fps)
+    return output
+
+
+def view(
+    scenario: Scenario,
+    result: Result | None = None,
+    *,
+    frames: int = 400,
+    start_s: float | None = None,
+    end_s: float | None = None,
+    options: RenderOptions | None = None,
+    lateral_scale: float | None = None,
+    lateral_about_mean: bool = True,
+    fps: float = 25.0,
+) -> None:
+    """Replay the result in Exudyn's interactive viewer (needs a display), ``fps`` frames per second."""
+    from .scene3d import VisualSystem
+
+    if not has_display():
+        raise RenderError("no display: the interactive viewer needs one; use render() for pictures")
+    layout = build_layout(scenario)
+    if result is None:
+        speed = scenario.design.motor.synchronous_speed_rad_s
+        result = kinematic_result(layout, speed, 2 * np.pi / speed)
+    check_result_matches(scenario, result)
+    times = frame_times(result, frames, start_s, end_s)
+    poses = body_poses(layout, result, times, lateral_scale, lateral_about_mean)
+    VisualSystem(layout, options).view_interactive(times, poses, 1.0 / fps)

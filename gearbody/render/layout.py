@@ -1,0 +1,403 @@
+"""Where every part of a drive sits in 3D, derived from the scenario alone (no Exudyn).
+
+Gear axes are parallel to z. Stage s's wheel axis lies one centre distance a_s = r_1 + r_2 (pitch
+radii r = r_b / cos(alpha), standard gears without profile shift) from its pinion axis, in the
+direction ``mesh.centre_line_deg`` of that stage, so a train of any length lays itself out. Stages
+follow each other along +z; the motor stands on the -z side of the input axis and the driven machine
+on the +z side of the output axis; bearings sit in the housing walls at both ends of every axis.
+
+Moving parts are grouped into :class:`Body` objects: one per rotating inertia of the model (motor
+rotor, each gear with its shaft, machine rotor). A body's parts are given in its own frame (origin on
+its axis at z = 0, rotating about +z); ground parts in the world frame. Sizes that the scenario does
+not give (shaft diameters, motor frame, housing) follow simple engineering rules stated where they
+are computed. Everything here is plain numbers so that the layout is testable without a renderer.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ..model import Scenario
+from ..physics.lateral import mesh_directions
+
+# Colours (RGBA).
+STEEL = (0.55, 0.6, 0.7, 1.0)
+WHEEL = (0.78, 0.72, 0.55, 1.0)
+SHAFT = (0.35, 0.35, 0.38, 1.0)
+MARKER = (0.95, 0.85, 0.1, 1.0)
+MOTOR = (0.16, 0.33, 0.6, 1.0)
+MACHINE = (0.25, 0.5, 0.3, 1.0)
+BEARING = (0.6, 0.45, 0.25, 1.0)
+HOUSING = (0.6, 0.62, 0.66, 0.22)
+BASE = (0.3, 0.3, 0.3, 1.0)
+DAMAGED = (0.9, 0.1, 0.1, 1.0)
+PITTED = (1.0, 0.55, 0.0, 1.0)
+COUPLING = (0.45, 0.45, 0.48, 1.0)
+
+#: allowable torsional shear stress for the drawn shaft diameters, d = (16 T / (pi tau))^(1/3)
+SHAFT_SHEAR_STRESS_PA = 30e6
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """Tube along z from z0_m to z1_m (body or world frame), centred on (x_m, y_m)."""
+
+    z0_m: float
+    z1_m: float
+    radius_m: float
+    colour: tuple[float, float, float, float]
+    inner_radius_m: float = 0.0
+    x_m: float = 0.0
+    y_m: float = 0.0
+
+
+@dataclass(frozen=True)
+class Box:
+    centre_m: tuple[float, float, float]
+    size_m: tuple[float, float, float]
+    colour: tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class GearShape:
+    """Spur gear in its body frame: teeth at angles ``first_tooth_rad + 2 pi k / z``."""
+
+    teeth: int
+    module_m: float
+    pressure_angle_deg: float
+    face_width_m: float
+    z_m: float
+    bore_radius_m: float
+    first_tooth_rad: float
+    colour: tuple[float, float, float, float]
+    # (body-frame angle of the tooth centre, colour) for damaged and pitted teeth
+    marked_teeth: tuple[tuple[float, tuple[float, float, float, float]], ...] = ()
+
+    @property
+    def pitch_radius_m(self) -> float:
+        return 0.5 * self.module_m * self.teeth
+
+    @property
+    def tip_radius_m(self) -> float:
+        return self.pitch_radius_m + self.module_m
+
+    @property
+    def root_radius_m(self) -> float:
+        return self.pitch_radius_m - 1.25 * self.module_m
+
+
+@dataclass(frozen=True)
+class Body:
+    """A rotating inertia of the model and what is drawn on it.
+
+    ``angle_signal`` names the result signal of its rotation; the drawn angle is ``sense * angle``
+    (each model rotation is positive in its own driven direction, so meshing gears turn opposite).
+    ``lateral_signals`` name its centre's x, y motion when the gear moves on bearings.
+    """
+
+    name: str
+    axis_xy_m: tuple[float, float]
+    sense: int
+    angle_signal: str
+    parts: tuple = ()
+    lateral_signals: tuple[str, str] | None = None
+    # kinematic fallback when the result has no angle signal for this body: angle = ratio * angle of
+    # body `follows` (rigid gear ratio; used by the Muller and two-wheel scenes)
+    follows: str | None = None
+    ratio: float = 1.0
+
+
+@dataclass
+class Layout:
+    bodies: list[Body] = field(default_factory=list)
+    ground: list = field(default_factory=list)
+    machines: list = field(default_factory=list)  # motor and driven-machine frames (ground)
+    housing: Box | None = None
+    show_housing: bool = False
+    lateral_scale: float = 1000.0
+
+    def body(self, name: str) -> Body:
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise KeyError(f"no body {name!r}; bodies: {', '.join(b.name for b in self.bodies)}")
+
+    @property
+    def gears(self) -> list[tuple[Body, GearShape]]:
+        return [(b, p) for b in self.bodies for p in b.parts if isinstance(p, GearShape)]
+
+    def bounds_m(
+        self, gears_only: bool = False
+    ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """Axis-aligned box around everything drawn, or around the gears only (for the camera)."""
+        lo, hi = [math.inf] * 3, [-math.inf] * 3
+
+        def grow(x0, x1, y0, y1, z0, z1):
+            for k, (a, b) in enumerate(((x0, x1), (y0, y1), (z0, z1))):
+                lo[k], hi[k] = min(lo[k], a, b), max(hi[k], a, b)
+
+        for b in self.bodies:
+            bx, by = b.axis_xy_m
+            for p in b.parts:
+                if isinstance(p, GearShape):
+                    r = p.tip_radius_m
+                    grow(
+                        bx - r, bx + r, by - r, by + r, p.z_m - p.face_width_m / 2, p.z_m + p.face_width_m / 2
+                    )
+                elif isinstance(p, Cylinder) and not gears_only:
+                    r = p.radius_m
+                    grow(bx - r, bx + r, by - r, by + r, p.z0_m, p.z1_m)
+        if gears_only:
+            return (tuple(lo), tuple(hi))
+        for p in [*self.ground, *self.machines, *([self.housing] if self.housing else [])]:
+            if isinstance(p, Box):
+                c, s = p.centre_m, p.size_m
+                grow(
+                    c[0] - s[0] / 2,
+                    c[0] + s[0] / 2,
+                    c[1] - s[1] / 2,
+                    c[1] + s[1] / 2,
+                    c[2] - s[2] / 2,
+                    c[2] + s[2] / 2,
+                )
+            elif isinstance(p, Cylinder):
+                grow(
+                    p.x_m - p.radius_m,
+                    p.x_m + p.radius_m,
+                    p.y_m - p.radius_m,
+                    p.y_m + p.radius_m,
+                    p.z0_m,
+                    p.z1_m,
+                )
+        return (tuple(lo), tuple(hi))
+
+
+def module_m(base_radius_m: float, teeth: int, pressure_angle_deg: float) -> float:
+    """m = 2 r_b / (z cos alpha)."""
+    return 2 * base_radius_m / (teeth * math.cos(math.radians(pressure_angle_deg)))
+
+
+def shaft_radius_m(torque_Nm: float) -> float:
+    """Solid shaft sized for the torque: d = (16 T / (pi tau))^(1/3), tau = 30 MPa."""
+    return 0.5 * (16 * abs(torque_Nm) / (math.pi * SHAFT_SHEAR_STRESS_PA)) ** (1 / 3)
+
+
+def tooth_angle_rad(gear: str, tooth: int, teeth: int, sense: int, centre_line_rad: float) -> float:
+    """Body-frame angle of the centre of model tooth ``tooth`` (docs/render.md, "Teeth").
+
+    The model meshes pinion tooth i = floor(phi_p z1 / 2 pi) mod z1 with wheel tooth j = the same
+    pair count mod z2. The pinion tooth i is centred on the centre line in the middle of its mesh
+    period; the wheel tooth j sits half a pitch ahead of it in the direction of motion, so the drawn
+    teeth interleave.
+    """
+    pitch = 2 * math.pi / teeth
+    if gear == "pinion":
+        return centre_line_rad - sense * (tooth + 0.5) * pitch
+    return centre_line_rad + math.pi - sense * tooth * pitch
+
+
+def build_layout(scenario: Scenario) -> Layout:
+    """The 3D layout of a scenario's drive (see the module docstring)."""
+    stages = scenario.stages
+    d = scenario.design
+    mods = [module_m(st.pinion.base_radius_m, st.pinion.teeth, st.mesh.pressure_angle_deg) for st in stages]
+    widths = [
+        (st.pinion.face_width_m or 10 * m, st.wheel.face_width_m or 10 * m)
+        for st, m in zip(stages, mods, strict=True)
+    ]
+    faces = [max(b) for b in widths]
+    gap = 0.5 * max(faces)
+    z_stage = [0.0]  # axial position of each stage's mid-plane
+    for k in range(1, len(stages)):
+        z_stage.append(z_stage[-1] + 0.5 * (faces[k - 1] + faces[k]) + gap)
+    wall = 0.06 * max(faces) + 0.02
+    z_front = z_stage[0] - faces[0] / 2 - gap - wall / 2
+    z_back = z_stage[-1] + faces[-1] / 2 + gap + wall / 2
+
+    # rated torque on each axis: the machine torque passed upstream through the ratios
+    torques = [d.machine.rated_torque_Nm]
+    for st in reversed(stages):
+        torques.insert(0, torques[0] / st.ratio)
+    axes = [(0.0, 0.0)]  # axis positions: one centre distance per stage along its centre line
+    for st in stages:
+        gam = math.radians(st.mesh.centre_line_deg)
+        a = (st.pinion.base_radius_m + st.wheel.base_radius_m) / math.cos(
+            math.radians(st.mesh.pressure_angle_deg)
+        )
+        axes.append((axes[-1][0] + a * math.cos(gam), axes[-1][1] + a * math.sin(gam)))
+    # the input shaft turns as stage 1's line of action says (the lateral models' convention);
+    # every further axis turns the other way
+    senses = [mesh_directions(stages[0].mesh.centre_line_deg, stages[0].mesh.line_of_action_deg)[2]]
+    for _ in stages:
+        senses.append(-senses[-1])
+    names = [("pinion", "wheel")] + [(f"pinion_{k + 1}", f"wheel_{k + 1}") for k in range(1, len(stages))]
+
+    def root_radius(gear, m):
+        return 0.5 * m * gear.teeth - 1.25 * m
+
+    def hub(z0, z1, r):
+        """Coupling half with a marker stripe that shows its rotation."""
+        return (
+            Cylinder(z0, z1, 1.9 * r, COUPLING),
+            Box((1.75 * r, 0.0, 0.5 * (z0 + z1)), (0.4 * r, 0.5 * r, 1.02 * abs(z1 - z0)), MARKER),
+        )
+
+    layout = Layout(lateral_scale=scenario.visual.lateral_scale)
+    power_kW = d.machine.rated_torque_Nm / scenario.gear_ratio * d.motor.synchronous_speed_rad_s / 1e3
+    frame_d = 0.13 * max(power_kW, 0.5) ** (1 / 3)  # IEC frame diameter ~ P^(1/3): 75 kW -> 0.55 m
+
+    # motor rotor: shaft stub and coupling half
+    r_in = min(shaft_radius_m(torques[0]), 0.8 * root_radius(stages[0].pinion, mods[0]))
+    hub_len = 1.6 * r_in
+    z_cpl_in = z_front - wall / 2 - 0.5 * gap - hub_len
+    z_motor = z_cpl_in - hub_len - 0.4 * gap
+    motor_len = 1.8 * frame_d
+    layout.bodies.append(
+        Body(
+            "motor",
+            axes[0],
+            senses[0],
+            "motor_angle_rad",
+            (
+                Cylinder(z_motor, z_cpl_in - hub_len, r_in, SHAFT),
+                *hub(z_cpl_in - hub_len, z_cpl_in - 0.002, r_in),
+            ),
+            follows="pinion",
+        )
+    )
+
+    # gears with their shafts; bearings in both housing walls, once per axis
+    axis_shaft_r: dict[int, float] = {}
+    for k, st in enumerate(stages):
+        gam = math.radians(st.mesh.centre_line_deg)
+        m = mods[k]
+        marks = {(t.gear, t.tooth): DAMAGED for t in st.damaged_teeth if t.stiffness_factor < 1}
+        marks.update({(t.gear, t.tooth): PITTED for t in st.pitted_teeth if t.depth_um > 0})
+        for which, gear, b, colour in (
+            ("pinion", st.pinion, widths[k][0], STEEL),
+            ("wheel", st.wheel, widths[k][1], WHEEL),
+        ):
+            j = k if which == "pinion" else k + 1  # axis index
+            name = names[k][0 if which == "pinion" else 1]
+            shaft_r = min(shaft_radius_m(torques[j]), 0.8 * root_radius(gear, m))
+            shape = GearShape(
+                teeth=gear.teeth,
+                module_m=m,
+                pressure_angle_deg=st.mesh.pressure_angle_deg,
+                face_width_m=b,
+                z_m=z_stage[k],
+                bore_radius_m=0.98 * shaft_r,
+                first_tooth_rad=tooth_angle_rad(which, 0, gear.teeth, senses[j], gam),
+                colour=colour,
+                marked_teeth=tuple(
+                    (tooth_angle_rad(which, i, gear.teeth, senses[j], gam), c)
+                    for (g, i), c in sorted(marks.items())
+                    if g == which
+                ),
+            )
+            parts: list = [shape]
+            if which == "pinion" and k == 0:  # input shaft from the coupling through the box
+                parts += [
+                    Cylinder(z_cpl_in, z_back, shaft_r, SHAFT),
+                    *hub(z_cpl_in + 0.002, z_cpl_in + hub_len, r_in),
+                ]
+            elif which == "pinion":  # back half of the intermediate shaft
+                parts.append(Cylinder(0.5 * (z_stage[k - 1] + z_stage[k]), z_back, shaft_r, SHAFT))
+            elif k < len(stages) - 1:  # front half of the intermediate shaft
+                parts.append(Cylinder(z_front, 0.5 * (z_stage[k] + z_stage[k + 1]), shaft_r, SHAFT))
+            else:  # output shaft out of the back wall to the machine coupling
+                z_cpl_out = z_back + wall / 2 + 0.5 * gap + 1.6 * shaft_r
+                parts += [
+                    Cylinder(z_front, z_cpl_out, shaft_r, SHAFT),
+                    *hub(z_cpl_out - 1.6 * shaft_r, z_cpl_out - 0.002, shaft_r),
+                ]
+            follows, ratio = (
+                (None, 1.0)
+                if (which, k) == ("pinion", 0)
+                else (
+                    (names[k][0], st.pinion.teeth / st.wheel.teeth)
+                    if which == "wheel"
+                    else (names[k - 1][1], 1.0)
+                )
+            )
+            lateral = (f"{name}_x_m", f"{name}_y_m") if gear.lateral != "none" else None
+            layout.bodies.append(
+                Body(name, axes[j], senses[j], f"{name}_angle_rad", tuple(parts), lateral, follows, ratio)
+            )
+            axis_shaft_r[j] = max(axis_shaft_r.get(j, 0.0), shaft_r)
+
+    for j, shaft_r in axis_shaft_r.items():
+        for zw in (z_front, z_back):
+            layout.ground.append(
+                Cylinder(
+                    zw - wall / 2,
+                    zw + wall / 2,
+                    1.8 * shaft_r,
+                    BEARING,
+                    inner_radius_m=1.05 * shaft_r,
+                    x_m=axes[j][0],
+                    y_m=axes[j][1],
+                )
+            )
+
+    # driven machine: coupling half and shaft stub
+    r_out = min(shaft_radius_m(torques[-1]), 0.8 * root_radius(stages[-1].wheel, mods[-1]))
+    z_cpl_out = z_back + wall / 2 + 0.5 * gap + 1.6 * r_out
+    mach_d = 1.1 * frame_d
+    z_mach = z_cpl_out + 1.6 * r_out + 0.4 * gap
+    layout.bodies.append(
+        Body(
+            "machine",
+            axes[-1],
+            senses[-1],
+            "machine_angle_rad",
+            (
+                *hub(z_cpl_out + 0.002, z_cpl_out + 1.6 * r_out, r_out),
+                Cylinder(z_cpl_out + 1.6 * r_out, z_mach, r_out, SHAFT),
+            ),
+            follows=names[-1][1],
+        )
+    )
+
+    # housing, motor and machine frames standing on a base plate
+    rmax = max(p.tip_radius_m for _, p in layout.gears)
+    margin = 0.1 * rmax + 0.03
+    xs, ys = [x for x, _ in axes], [y for _, y in axes]
+    hx0, hx1 = min(xs) - rmax - margin, max(xs) + rmax + margin
+    hy0, hy1 = min(ys) - rmax - margin, max(ys) + rmax + margin
+    housing = Box(
+        ((hx0 + hx1) / 2, (hy0 + hy1) / 2, (z_front + z_back) / 2),
+        (hx1 - hx0, hy1 - hy0, z_back - z_front + wall),
+        HOUSING,
+    )
+    layout.housing, layout.show_housing = housing, scenario.visual.housing
+    (x0, y0), (xo, yo) = axes[0], axes[-1]
+    floor = min(hy0, y0 - frame_d / 2, yo - mach_d / 2) - 0.02
+    layout.machines += [
+        Cylinder(z_motor - motor_len, z_motor, frame_d / 2, MOTOR, x_m=x0, y_m=y0),
+        Box(
+            (x0, 0.5 * (floor + y0), z_motor - motor_len / 2),
+            (0.75 * frame_d, y0 - floor, 0.8 * motor_len),
+            MOTOR,
+        ),
+        Box((xo, yo, z_mach + 0.6 * mach_d), (mach_d, mach_d, 1.2 * mach_d), MACHINE),
+        Box(
+            (xo, 0.5 * (floor + yo), z_mach + 0.6 * mach_d), (0.8 * mach_d, yo - floor, 1.1 * mach_d), MACHINE
+        ),
+    ]
+    # gearbox feet under the housing
+    layout.ground.append(
+        Box(
+            ((hx0 + hx1) / 2, 0.5 * (floor + hy0), (z_front + z_back) / 2),
+            (0.999 * (hx1 - hx0), max(hy0 - floor, 0.01) - 0.002, 0.999 * (z_back - z_front)),
+            HOUSING[:3] + (1.0,),
+        )
+    )
+    zlo, zhi = z_motor - motor_len - 0.1, z_mach + 1.2 * mach_d + 0.1
+    xlo = min(hx0, x0 - frame_d / 2, xo - mach_d / 2) - 0.1
+    xhi = max(hx1, x0 + frame_d / 2, xo + mach_d / 2) + 0.1
+    layout.ground.append(
+        Box(((xlo + xhi) / 2, floor - 0.02, (zlo + zhi) / 2), (xhi - xlo, 0.04, zhi - zlo), BASE)
+    )
+    return layout

@@ -1,0 +1,169 @@
+"""Headless pictures of a simulated drive (Exudyn's software raytracer, no display)."""
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from gearbody.cli import main
+from gearbody.engine import simulate
+from gearbody.model import load_scenario
+from gearbody.render import RenderError, RenderOptions, build_layout, render, render_images, view
+from gearbody.render.poses import body_poses
+from gearbody.render.scene3d import VisualSystem
+
+W, H = 320, 240
+
+
+@pytest.fixture(scope="module")
+def one_stage():
+    sc = load_scenario("one-stage", ["operation.t_end_s=0.03", 'operation.initial_state="steady"'])
+    return sc, simulate(sc)
+
+
+def _moving_mask(scenario, result, t, options):
+    """Pixels covered by the moving bodies at time t: full picture vs the ground-only picture."""
+    layout = build_layout(scenario)
+    pose = body_poses(layout, result, np.array([t]))[0]
+    images = []
+    for bodies in (True, False):
+        vs = VisualSystem(layout, options, bodies=bodies)
+        vs.set_camera()
+        vs.set_pose(pose, t)
+        images.append(vs.image().astype(int))
+    return np.abs(images[0] - images[1]).sum(axis=2) > 0
+
+
+def test_two_frames_of_one_stage_have_size_content_and_differ_where_gears_turn(one_stage, tmp_path):
+    sc, res = one_stage
+    times = [0.02, 0.023]  # the pinion turns ~0.32 rad = 1.5 tooth pitches in between
+    options = RenderOptions(width_px=W, height_px=H, view="front", frame="gears")
+    out = render(sc, res, out_dir=tmp_path, frames=2, start_s=times[0], end_s=times[1], options=options)
+    assert [p.name for p in out.frames] == ["frame_0000.png", "frame_0001.png"]
+    a, b = (np.asarray(Image.open(p).convert("RGB")).astype(int) for p in out.frames)
+    assert a.shape == b.shape == (H, W, 3)
+    # not blank: a good part of the picture is not background, in several colours
+    background = np.all(a == 255, axis=2)
+    assert 0.1 < 1 - background.mean() < 0.98
+    assert len(np.unique(a.reshape(-1, 3), axis=0)) >= 5  # gears, shafts, hubs, bearings, background
+    # the frames differ, and only where the moving bodies are (gears, shafts, hubs)
+    changed = np.abs(a - b).sum(axis=2) > 0
+    assert changed.mean() > 0.002  # teeth and hub markers move; discs look the same
+    moving = _moving_mask(sc, res, times[0], options) | _moving_mask(sc, res, times[1], options)
+    assert (changed & ~moving).sum() <= 0.01 * changed.sum()
+    # the animation holds both frames at the requested size
+    gif = Image.open(out.movie)
+    assert gif.size == (W, H) and gif.n_frames == 2
+
+
+def test_same_pose_gives_the_same_picture(one_stage):
+    sc, res = one_stage
+    opts = RenderOptions(width_px=160, height_px=120)
+    ((_, a),) = render_images(sc, res, [0.02], opts)
+    ((_, b),) = render_images(sc, res, [0.02], opts)
+    assert np.array_equal(a, b)
+
+
+def test_damaged_tooth_shows_red(tmp_path):
+    sc = load_scenario(
+        "one-stage", ['condition.damaged_teeth=[{gear="pinion", tooth=0, stiffness_factor=0.5}]']
+    )
+    layout = build_layout(sc)
+    opts = RenderOptions(width_px=W, height_px=H, view="back", frame="gears")
+
+    def red_pixels(scenario):
+        vs = VisualSystem(build_layout(scenario), opts)
+        vs.set_camera()
+        vs.set_pose(np.zeros(3 * len(layout.bodies)))
+        img = vs.image().astype(int)
+        return ((img[..., 0] > 150) & (img[..., 1] < 80) & (img[..., 2] < 80)).sum()
+
+    assert red_pixels(sc) > 20 and red_pixels(load_scenario("one-stage")) == 0
+
+
+def test_cli_render_writes_frames_and_gif_without_display(tmp_path, monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    out = tmp_path / "pics"
+    code = main(
+        [
+            "render",
+            "one-stage",
+            "--kinematic",
+            "--frames",
+            "3",
+            "--width",
+            "160",
+            "--height",
+            "120",
+            "--out",
+            str(out),
+            "--quiet",
+        ]
+    )
+    assert code == 0
+    assert sorted(p.name for p in out.glob("*.png")) == ["frame_0000.png", "frame_0001.png", "frame_0002.png"]
+    assert Image.open(out / "animation.gif").n_frames == 3
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--frames", "0"], "frames = 0"),
+        (["--view", "sideways"], "view = 'sideways'"),
+        (["--width", "5"], "width_px = 5"),
+        (["--zoom", "0"], "zoom = 0"),
+        (["--start", "5.0"], "start_s = 5"),
+        (["--background", "1,1"], "--background"),
+    ],
+)
+def test_cli_render_bad_options_name_the_value(tmp_path, capsys, args, message):
+    code = main(["render", "one-stage", "--kinematic", "--out", str(tmp_path), "--quiet", *args])
+    assert code == 2
+    assert message in capsys.readouterr().err
+
+
+def test_cli_render_refuses_missing_result(tmp_path, capsys):
+    assert main(["render", "one-stage", "--result", str(tmp_path), "--quiet"]) == 2
+    assert "no result.npz" in capsys.readouterr().err
+
+
+def test_interactive_view_needs_a_display_and_its_solution_replays_the_poses(one_stage, monkeypatch):
+    import exudyn as exu
+    from exudyn.basicUtilities import SetSolutionState
+
+    sc, res = one_stage
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    with pytest.raises(RenderError, match="display"):
+        view(sc, res)
+    layout = build_layout(sc)
+    times = np.array([0.01, 0.02])
+    poses = body_poses(layout, res, times)
+    vs = VisualSystem(layout, RenderOptions(width_px=64, height_px=48))
+    solution = vs.solution(times, poses)
+    SetSolutionState(vs.mbs, solution, 1, exu.ConfigurationType.Visualization, sendRedrawSignal=False)
+    assert vs.mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Visualization) == pytest.approx(
+        poses[1]
+    )
+
+
+def test_cli_render_simulates_keeps_the_result_and_rerenders_it(tmp_path):
+    out = tmp_path / "r"
+    args = [
+        "render",
+        "one-stage",
+        "--set",
+        'operation.initial_state="steady"',
+        "--width",
+        "96",
+        "--height",
+        "72",
+    ]
+    assert main([*args, "--t-end", "0.02", "--frames", "2", "--out", str(out), "--quiet"]) == 0
+    assert (out / "result.npz").is_file() and (out / "scenario.toml").is_file()
+    assert (
+        main([*args, "--result", str(out), "--frames", "1", "--format", "none", "--out", str(out), "--quiet"])
+        == 0
+    )
+    assert sorted(p.name for p in out.glob("frame_*.png")) == ["frame_0000.png"]
+    assert not (out / "animation.gif").exists()  # the old movie went with the old frames
+    assert main([*args, "--result", str(out), "--t-end", "1", "--out", str(out), "--quiet"]) == 2
