@@ -21,6 +21,20 @@ EPILOG = """examples:
 """
 
 
+def _add_set(parser: argparse.ArgumentParser, help: str) -> None:
+    parser.add_argument(
+        "--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE", help=help
+    )
+
+
+def _overrides(args) -> list[str]:
+    """The --set overrides, plus operation.t_end_s from --t-end when given."""
+    overrides = list(args.overrides)
+    if args.t_end is not None:
+        overrides.append(f"operation.t_end_s={args.t_end!r}")
+    return overrides
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="gearbody",
@@ -46,13 +60,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument(
         "scene", metavar="SCENE", help="scene name (see 'gearbody list') or path to a .toml scenario"
     )
-    run.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a scenario value by its dotted key, e.g. production.error_mode.e_um=15 "
+    _add_set(
+        run,
+        "override a scenario value by its dotted key, e.g. production.error_mode.e_um=15 "
         '(repeatable; values are TOML: numbers, true/false, [arrays], "strings")',
     )
     run.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time (sets operation.t_end_s)")
@@ -69,14 +79,7 @@ def _parser() -> argparse.ArgumentParser:
         "modes", help="natural frequencies (Hz) at mean mesh stiffness, and resonance speeds"
     )
     modes.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
-    modes.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a scenario value (as for run)",
-    )
+    _add_set(modes, "override a scenario value (as for run)")
     modes.add_argument("--harmonics", type=int, default=3, help="mesh harmonics to list resonance speeds for")
 
     val = sub.add_parser(
@@ -125,14 +128,7 @@ def _parser() -> argparse.ArgumentParser:
         "--study-seed", type=int, default=0, metavar="S", help="seed of the random draws (default 0)"
     )
     sw.add_argument("--seeds", type=int, metavar="N", help="vary meta.seed (random tooth errors) over 1..N")
-    sw.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="fixed override of every case (as for run)",
-    )
+    _add_set(sw, "fixed override of every case (as for run)")
     sw.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time of every case")
     sw.add_argument(
         "--workers", type=int, metavar="N", help="local processes (default: all cores; 1: serial)"
@@ -173,14 +169,7 @@ def _parser() -> argparse.ArgumentParser:
     rd.add_argument(
         "--kinematic", action="store_true", help="no simulation: rigid rotation at synchronous speed"
     )
-    rd.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a scenario value (as for run)",
-    )
+    _add_set(rd, "override a scenario value (as for run)")
     rd.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time when simulating first")
     rd.add_argument(
         "--frames", type=int, metavar="N", help="number of frames (default 24; --interactive: 400)"
@@ -257,9 +246,7 @@ def cmd_run(args) -> int:
     from .model import dump_scenario
     from .summary import summarize, write_plots
 
-    overrides = list(args.overrides)
-    if args.t_end is not None:
-        overrides.append(f"operation.t_end_s={args.t_end!r}")
+    overrides = _overrides(args)
     scenario = _load(args.scene, overrides)
     out = args.out or Path("runs") / (Path(args.scene).stem if args.scene.endswith(".toml") else args.scene)
     out.mkdir(parents=True, exist_ok=True)
@@ -328,9 +315,7 @@ def cmd_validate(args) -> int:
 def cmd_sweep(args) -> int:
     from .sweep import SweepSpecError, run_study
 
-    overrides = list(args.overrides)
-    if args.t_end is not None:
-        overrides.append(f"operation.t_end_s={args.t_end!r}")
+    overrides = _overrides(args)
     try:
         study = run_study(
             args.scene,
@@ -361,9 +346,7 @@ def cmd_render(args) -> int:
     from .render import RenderError, RenderOptions, render, view
     from .result import Result
 
-    overrides = list(args.overrides)
-    if args.t_end is not None:
-        overrides.append(f"operation.t_end_s={args.t_end!r}")
+    overrides = _overrides(args)
     scenario = _load(args.scene, overrides)
     try:
         background = tuple(float(v) for v in args.background.split(","))

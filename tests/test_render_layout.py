@@ -159,8 +159,7 @@ def test_muller_scene_turns_rigidly_with_the_pinion():
 
 
 def test_frame_window_defaults_to_one_input_revolution():
-    layout = build_layout(load_scenario("one-stage"))
-    res = kinematic_result(layout, 100.0, 0.5)
+    res = kinematic_result(100.0, 0.5)
     times = frame_times(res, 10)
     span = 2 * math.pi / 100.0  # one input revolution; the frame at its start is left out (loops cleanly)
     assert times[-1] == pytest.approx(0.5)

@@ -61,6 +61,27 @@ def check_result_matches(scenario: Scenario, result: Result) -> None:
         )
 
 
+def _motion(scenario: Scenario, result: Result | None, until_s: float = 0.0) -> Result:
+    """The result to draw: the given one (checked against the drive), or rigid rotation at the
+    synchronous speed for one input revolution (at least until ``until_s``)."""
+    if result is None:
+        speed = scenario.design.motor.synchronous_speed_rad_s
+        return kinematic_result(speed, max(2 * np.pi / speed, until_s))
+    check_result_matches(scenario, result)
+    return result
+
+
+def _images(layout: Layout, result: Result, times_s, options, lateral_scale, lateral_about_mean):
+    from .scene3d import VisualSystem
+
+    poses = body_poses(layout, result, np.asarray(times_s, dtype=float), lateral_scale, lateral_about_mean)
+    system = VisualSystem(layout, options)
+    system.set_camera()
+    for t, row in zip(times_s, poses, strict=True):
+        system.set_pose(row, t)
+        yield float(t), system.image()
+
+
 def render_images(
     scenario: Scenario,
     result: Result | None,
@@ -71,19 +92,8 @@ def render_images(
 ):
     """Yield (time, RGB image) for each time: the drive in the result's pose, raytraced (no result:
     rigid rotation at the synchronous speed)."""
-    from .scene3d import VisualSystem
-
-    layout = build_layout(scenario)
-    if result is None:
-        speed = scenario.design.motor.synchronous_speed_rad_s
-        result = kinematic_result(layout, speed, max(2 * np.pi / speed, float(np.max(times_s))))
-    check_result_matches(scenario, result)
-    poses = body_poses(layout, result, np.asarray(times_s, dtype=float), lateral_scale, lateral_about_mean)
-    system = VisualSystem(layout, options)
-    system.set_camera()
-    for t, row in zip(times_s, poses, strict=True):
-        system.set_pose(row, t)
-        yield float(t), system.image()
+    result = _motion(scenario, result, float(np.max(times_s)))
+    yield from _images(build_layout(scenario), result, times_s, options, lateral_scale, lateral_about_mean)
 
 
 def render(
@@ -120,10 +130,7 @@ def render(
     options = options or RenderOptions()
     options.check()
     layout = build_layout(scenario)
-    if result is None:
-        speed = scenario.design.motor.synchronous_speed_rad_s
-        result = kinematic_result(layout, speed, 2 * np.pi / speed)
-    check_result_matches(scenario, result)
+    result = _motion(scenario, result)
     times = frame_times(result, frames, start_s, end_s)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -131,7 +138,7 @@ def render(
         old.unlink(missing_ok=True)
     output = RenderOutput(times_s=times)
     t0 = time.perf_counter()
-    images = render_images(scenario, result, times, options, lateral_scale, lateral_about_mean)
+    images = _images(layout, result, times, options, lateral_scale, lateral_about_mean)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -173,10 +180,7 @@ def view(
     if not has_display():
         raise RenderError("no display: the interactive viewer needs one; use render() for pictures")
     layout = build_layout(scenario)
-    if result is None:
-        speed = scenario.design.motor.synchronous_speed_rad_s
-        result = kinematic_result(layout, speed, 2 * np.pi / speed)
-    check_result_matches(scenario, result)
+    result = _motion(scenario, result)
     times = frame_times(result, frames, start_s, end_s)
     poses = body_poses(layout, result, times, lateral_scale, lateral_about_mean)
     VisualSystem(layout, options).view_interactive(times, poses, 1.0 / fps)

@@ -105,7 +105,7 @@ def body_poses(
     return poses
 
 
-def kinematic_result(layout: Layout, speed_rad_s: float, duration_s: float, samples: int = 2001) -> Result:
+def kinematic_result(speed_rad_s: float, duration_s: float, samples: int = 2001) -> Result:
     """A result of rigid rotation at ``speed_rad_s`` of the input shaft (no simulation): pictures of
     the machine alone."""
     t = np.linspace(0.0, duration_s, samples)
