@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from test_gear_geometry import iso_example_1 as example_1_geometry  # h_fP = 1.4 m_n, so C_B = 0.9
 
 from gearbody.physics import mean_stiffness_N_per_m, pack_mesh_parameters
 from gearbody.physics.gear_geometry import GearGeometryError, gear_pair_geometry
@@ -24,21 +25,6 @@ EXAMPLE_1 = {
     "c_gamma_alpha_N_per_mm_um": 17.465,
     "c_gamma_beta_N_per_mm_um": 14.845,
 }
-
-
-def example_1_geometry(**kw):
-    base = dict(
-        module_m=8e-3,
-        teeth_pinion=17,
-        teeth_wheel=103,
-        face_width_m=0.1,
-        helix_angle_deg=15.8,
-        profile_shift_pinion=0.145,
-        centre_distance_m=0.5,
-        dedendum_coefficient=1.4,  # h_fP = 1.4 m_n, so C_B = 0.9
-    )
-    base.update(kw)
-    return gear_pair_geometry(**base)
 
 
 def test_iso_tr_6336_30_example_1_is_reproduced_to_0_1_percent():
