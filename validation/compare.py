@@ -134,8 +134,33 @@ def case_scenario(scene: str, case: Case, short: bool = False):
         )
         for mesh in meshes:
             mesh["backlash_um"] = 0.0
+            for key in ("thickness_allowance_pinion_um", "thickness_allowance_wheel_um"):
+                mesh.get("geometry", {}).pop(key, None)
         scenario = load_scenario(data)
     return scenario
+
+
+def reference_input(scenario) -> dict:
+    """The resolved scenario dict handed to the reference, with each potential-energy mesh's pair
+    stiffness table added as data (``mesh.pair_table``, docs/scenario.md "Pair stiffness table"): the
+    stiffness computation is checked by its own tests; the reference implements the law that uses it."""
+    from gearbody.model import scenario_to_dict
+    from gearbody.physics.mesh_stiffness import stage_pair_table
+
+    data = scenario_to_dict(scenario)
+    train = "stages" in data["design"]
+    meshes = [st["mesh"] for st in data["design"]["stages"]] if train else [data["design"]["mesh"]]
+    for stage, mesh in zip(scenario.stages, meshes, strict=True):
+        if stage.mesh.stiffness_profile == "potential-energy":
+            table = stage_pair_table(stage)
+            mesh["pair_table"] = {
+                "stiffness_N_per_m": table.stiffness_N_per_m.tolist(),
+                "ratios": [
+                    {"gear": gear, "tooth": tooth, "ratio": ratio.tolist()}
+                    for (gear, tooth), ratio in sorted(table.ratios.items())
+                ],
+            }
+    return data
 
 
 def bearing_force_errors_percent(res, ref: dict) -> dict[str, float]:
@@ -160,7 +185,6 @@ def compare_case(
     """Run gearbody and the reference on one case; the error is the worst stage's max |dF|/F_rated,s,
     and in lateral scenes also the worst bearing force's max error over its peak."""
     from gearbody.engine import simulate
-    from gearbody.model import scenario_to_dict
 
     from .reference import simulate_reference
     from .reference_lateral import simulate_reference_lateral
@@ -170,7 +194,7 @@ def compare_case(
     res = simulate(scenario)
     t1 = time.perf_counter()
     reference = simulate_reference_lateral if scenario.is_lateral else simulate_reference
-    ref = reference(scenario_to_dict(scenario), t_eval=res.time_s)
+    ref = reference(reference_input(scenario), t_eval=res.time_s)
     t2 = time.perf_counter()
     err = np.zeros_like(res.time_s)
     for k in range(len(scenario.stages)):

@@ -85,13 +85,15 @@ LATERAL = ("none", "y", "xy")
 @dataclass(frozen=True, kw_only=True)
 class Gear:
     teeth: int = param(ge=6, doc="number of teeth z")
-    base_radius_m: float = param(gt=0, doc="base radius r_b")
+    base_radius_m: float | None = param(
+        None, gt=0, doc="base radius r_b (required unless the mesh has a [geometry] table)"
+    )
     inertia_kg_m2: float = param(gt=0, doc="polar moment of inertia")
     mass_kg: float = param(gt=0, doc="mass (lateral models)")
     lateral: str = param("none", choices=LATERAL, doc="free translations of the gear centre")
     bearing: Bearing | None = param(None, doc="bearing to the housing (required when lateral)")
     face_width_m: float | None = param(
-        None, gt=0, le=2, doc="face width b (pictures; unset: 10 modules)"
+        None, gt=0, le=2, doc="face width b (pictures; from the mesh geometry; unset: 10 modules)"
     )
 
     def __post_init__(self) -> None:
@@ -112,22 +114,96 @@ class Machine:
     rated_torque_Nm: float = param(gt=0, doc="load torque at rated load on the machine shaft")
 
 
+STIFFNESS_PROFILES = ("contact-ratio", "table", "iso-6336-b", "potential-energy")
+FROM_GEOMETRY = ("iso-6336-b", "potential-energy")
+
+
+@dataclass(frozen=True, kw_only=True)
+class MeshGeometry:
+    """Gear-pair geometry of a mesh (docs/scenario.md, "Gear geometry"): base radii, contact ratio,
+    pitch point, working pressure angle, face width, backlash and the stiffness follow from it."""
+
+    module_mm: float = param(gt=0, le=100, doc="normal module m_n")
+    pressure_angle_deg: float = param(20.0, ge=10, le=35, doc="basic-rack (normal) pressure angle alpha_n")
+    helix_angle_deg: float = param(0.0, ge=0, le=45, doc="helix angle beta (iso-6336-b only)")
+    face_width_mm: float = param(gt=0, le=2000, doc="common face width b")
+    profile_shift_pinion: float = param(0.0, ge=-1.5, le=1.5, doc="profile shift coefficient x_1")
+    profile_shift_wheel: float = param(0.0, ge=-1.5, le=1.5, doc="profile shift coefficient x_2")
+    addendum_coefficient: float = param(1.0, gt=0, le=2, doc="h_a* of the basic rack")
+    dedendum_coefficient: float = param(1.25, gt=0, le=2, doc="h_f* of the basic rack")
+    rack_tip_radius_coefficient: float | None = param(
+        None, ge=0, le=1, doc="rho_fP* of the basic rack (unset: full round, 0.38 for ISO 53 A)"
+    )
+    centre_distance_mm: float | None = param(
+        None, gt=0, doc="working centre distance (unset: from the shifts)"
+    )
+    bore_diameter_pinion_mm: float | None = param(
+        None, gt=0, doc="pinion bore (potential-energy: fillet-foundation term)"
+    )
+    bore_diameter_wheel_mm: float | None = param(
+        None, gt=0, doc="wheel bore (potential-energy: fillet-foundation term)"
+    )
+    youngs_modulus_GPa: float = param(206.0, gt=0, le=1000, doc="Young's modulus of both gears")
+    poisson_ratio: float = param(0.3, ge=0, lt=0.5, doc="Poisson's ratio of both gears")
+    thickness_allowance_pinion_um: float | None = param(
+        None, ge=-2000, le=0, doc="E_sn1, normal tooth-thickness allowance (sets backlash_um)"
+    )
+    thickness_allowance_wheel_um: float | None = param(
+        None, ge=-2000, le=0, doc="E_sn2, normal tooth-thickness allowance (sets backlash_um)"
+    )
+    centre_distance_deviation_um: float = param(
+        0.0, ge=-2000, le=2000, doc="actual minus nominal centre distance (with the allowances)"
+    )
+    table_points: int = param(
+        81, ge=11, le=2001, doc="potential-energy: points of the pair stiffness table over its contact"
+    )
+
+    @property
+    def sets_backlash(self) -> bool:
+        """True when tooth-thickness allowances are given (the mesh's backlash_um follows from them)."""
+        return self.thickness_allowance_pinion_um is not None or self.thickness_allowance_wheel_um is not None
+
+
+MESH_DEFAULTS = {
+    "stiffness_single_N_per_m": 1.2e9,
+    "stiffness_double_N_per_m": 1.3e9,
+    "contact_ratio": 1.6,
+    "pressure_angle_deg": 20.0,
+    "pitch_point_phase": 0.5,
+}
+
+
 @dataclass(frozen=True, kw_only=True)
 class Mesh:
     """Gear mesh: stiffness profile k_z(p), damping C_z, backlash l_u, friction geometry."""
 
     stiffness_profile: str = param(
-        "contact-ratio", choices=("contact-ratio", "table"), doc="how k_z(p) is given"
+        "contact-ratio", choices=STIFFNESS_PROFILES, doc="how k_z(p) is given (or computed from geometry)"
     )
-    stiffness_single_N_per_m: float = param(1.2e9, gt=0, doc="k_z with one tooth pair in contact")
-    stiffness_double_N_per_m: float = param(1.3e9, gt=0, doc="k_z with two tooth pairs in contact")
-    contact_ratio: float = param(1.6, ge=1, lt=2, doc="transverse contact ratio eps_alpha")
+    geometry: MeshGeometry | None = param(
+        None, doc="gear-pair geometry; required by iso-6336-b and potential-energy"
+    )
+    stiffness_single_N_per_m: float | None = param(
+        None, gt=0, doc="k_z with one tooth pair in contact (default 1.2e9; geometry: computed)"
+    )
+    stiffness_double_N_per_m: float | None = param(
+        None, gt=0, doc="k_z with two tooth pairs in contact (default 1.3e9; geometry: computed)"
+    )
+    contact_ratio: float | None = param(
+        None, ge=1, lt=2, doc="transverse contact ratio eps_alpha (default 1.6; geometry: computed)"
+    )
     table_phase: tuple[float, ...] = param((), doc="mesh phases in [0, 1) of a k_z table")
     table_stiffness_N_per_m: tuple[float, ...] = param((), doc="k_z at table_phase")
     damping_Ns_per_m: float = param(0.0, ge=0, doc="mesh damping C_z")
-    backlash_um: float = param(0.0, ge=0, doc="l_u: half-width of the dead zone of eq. (4)")
-    pressure_angle_deg: float = param(20.0, gt=0, lt=45, doc="operating pressure angle")
-    pitch_point_phase: float = param(0.5, ge=0, le=1, doc="mesh phase where friction reverses")
+    backlash_um: float | None = param(
+        None, ge=0, doc="l_u: half-width of the dead zone of eq. (4) (default 0; geometry: from allowances)"
+    )
+    pressure_angle_deg: float | None = param(
+        None, gt=0, lt=45, doc="operating pressure angle (default 20; geometry: working transverse angle)"
+    )
+    pitch_point_phase: float | None = param(
+        None, ge=0, le=1, doc="mesh phase where friction reverses (default 0.5; geometry: computed)"
+    )
     centre_line_deg: float = param(
         0.0, ge=-360, le=360, doc="direction from pinion to wheel centre (lateral models)"
     )
@@ -143,10 +219,23 @@ class Mesh:
     )
 
     def __post_init__(self) -> None:
+        if self.stiffness_profile in FROM_GEOMETRY and self.geometry is None:
+            raise ScenarioError(
+                f"stiffness_profile = {self.stiffness_profile!r} computes k_z from the gears: add a "
+                "[geometry] table (module_mm, face_width_mm, ...)"
+            )
+        if self.geometry is None:  # hand-given mesh: fill the documented defaults
+            for key, value in MESH_DEFAULTS.items():
+                if getattr(self, key) is None:
+                    object.__setattr__(self, key, value)
+        if self.backlash_um is None and (self.geometry is None or not self.geometry.sets_backlash):
+            object.__setattr__(self, "backlash_um", 0.0)
+        if self.contact_ratio is None:  # geometry not yet resolved (Scenario resolves it)
+            return
         w = self.transition_width
         if w > 0:
             h = 0.5 * (self.contact_ratio - 1.0)
-            if self.stiffness_profile == "contact-ratio" and h > 0 and w > min(2 * h, 1 - 2 * h):
+            if self.stiffness_profile != "table" and h > 0 and w > min(2 * h, 1 - 2 * h):
                 raise ScenarioError(
                     f"transition_width = {w:g} with contact_ratio = {self.contact_ratio:g}: the width must "
                     f"not exceed the double or the single contact zone, <= {min(2 * h, 1 - 2 * h):g}"
@@ -256,9 +345,34 @@ class Operation:
 
 @dataclass(frozen=True, kw_only=True)
 class DamagedTooth:
+    """A damaged tooth: a bare stiffness factor (the paper's Figs. 13-16) and/or, with the
+    potential-energy stiffness, a root crack, a broken-off tip or a spall that give that tooth's pair its
+    own stiffness profile over its contact (docs/scenario.md, "Tooth damage from geometry")."""
+
     gear: str = param(choices=("pinion", "wheel"))
     tooth: int = param(ge=0, doc="tooth index, 0-based")
-    stiffness_factor: float = param(ge=0, le=1, doc="factor on k_z while this tooth meshes")
+    stiffness_factor: float = param(1.0, ge=0, le=1, doc="factor on k_z while this tooth meshes")
+    crack_depth_mm: float = param(0.0, ge=0, le=100, doc="root crack depth q (potential-energy)")
+    crack_angle_deg: float = param(45.0, gt=0, le=90, doc="crack angle to the tooth centre line")
+    broken_height_fraction: float = param(
+        0.0, ge=0, le=1, doc="part of the tooth height missing from the tip (potential-energy)"
+    )
+    broken_width_fraction: float = param(1.0, ge=0, le=1, doc="part of the face width it is missing over")
+    spall_start_diameter_mm: float = param(0.0, ge=0, doc="spall from this diameter of the flank")
+    spall_end_diameter_mm: float = param(0.0, ge=0, doc="spall up to this diameter")
+    spall_width_fraction: float = param(0.0, ge=0, le=1, doc="part of the contact width lost in the spall")
+
+    def __post_init__(self) -> None:
+        if self.spall_width_fraction > 0 and not self.spall_end_diameter_mm > self.spall_start_diameter_mm:
+            raise ScenarioError(
+                f"spall_end_diameter_mm = {self.spall_end_diameter_mm:g}: must be > spall_start_diameter_mm "
+                f"= {self.spall_start_diameter_mm:g} when spall_width_fraction > 0"
+            )
+
+    @property
+    def has_geometric_damage(self) -> bool:
+        """True when a crack, breakage or spall is given (needs the potential-energy stiffness)."""
+        return self.crack_depth_mm > 0 or self.broken_height_fraction > 0 or self.spall_width_fraction > 0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -342,37 +456,8 @@ class Scenario:
     visual: Visual = param(default_factory=Visual)
 
     def __post_init__(self) -> None:
-        d = self.design
-        if self.meta.scene == "train":
-            if (
-                d.pinion is not None
-                or d.wheel is not None
-                or d.coupling is not None
-                or d.output_shaft is not None
-            ):
-                raise ScenarioError(
-                    "a 'train' describes its gears in [[design.stages]] and its shafts in "
-                    "[[design.shafts]]; remove design.pinion/wheel/coupling/output_shaft"
-                )
-            if not d.stages:
-                raise ScenarioError("design.stages: a 'train' needs at least one [[design.stages]] entry")
-            if len(d.shafts) != len(d.stages) + 1:
-                raise ScenarioError(
-                    f"design.shafts has {len(d.shafts)} entries: a train of {len(d.stages)} "
-                    f"stage(s) needs {len(d.stages) + 1} (motor->stage 1, ..., last stage->machine)"
-                )
-        else:
-            if d.stages or d.shafts:
-                raise ScenarioError(
-                    f"design.stages / design.shafts belong to scene 'train', not {self.meta.scene!r}"
-                )
-            for name in ("pinion", "wheel"):
-                if getattr(d, name) is None:
-                    raise ScenarioError(f"design.{name} is required for scene {self.meta.scene!r}")
-            if self.meta.scene == "one-stage":
-                for name in ("coupling", "output_shaft"):
-                    if getattr(d, name) is None:
-                        raise ScenarioError(f"design.{name} is required for scene 'one-stage'")
+        self._check_topology()
+        self._resolve_geometry()
         for k, stage in enumerate(self.stages):
             where = f"design.stages[{k}]." if self.meta.scene == "train" else "design."
             pb1 = 2 * math.pi * stage.pinion.base_radius_m / stage.pinion.teeth
@@ -434,9 +519,9 @@ class Scenario:
                 sense = -sense
         if self.meta.scene in ("muller", "two-wheel"):
             for name in ("pinion", "wheel"):
-                if getattr(d, name).lateral != "none":
+                if getattr(self.design, name).lateral != "none":
                     raise ScenarioError(
-                        f"design.{name}.lateral = {getattr(d, name).lateral!r}: scene "
+                        f"design.{name}.lateral = {getattr(self.design, name).lateral!r}: scene "
                         f"{self.meta.scene!r} has no lateral motion; use 'one-stage' or 'train'"
                     )
         if self.solver.output_rate_hz * self.operation.t_end_s < 2:
@@ -444,6 +529,85 @@ class Scenario:
                 f"solver.output_rate_hz = {self.solver.output_rate_hz}: gives fewer than 2 "
                 f"samples over t_end_s = {self.operation.t_end_s}"
             )
+
+    def _check_topology(self) -> None:
+        d = self.design
+        if self.meta.scene == "train":
+            if (
+                d.pinion is not None
+                or d.wheel is not None
+                or d.coupling is not None
+                or d.output_shaft is not None
+            ):
+                raise ScenarioError(
+                    "a 'train' describes its gears in [[design.stages]] and its shafts in "
+                    "[[design.shafts]]; remove design.pinion/wheel/coupling/output_shaft"
+                )
+            if not d.stages:
+                raise ScenarioError("design.stages: a 'train' needs at least one [[design.stages]] entry")
+            if len(d.shafts) != len(d.stages) + 1:
+                raise ScenarioError(
+                    f"design.shafts has {len(d.shafts)} entries: a train of {len(d.stages)} "
+                    f"stage(s) needs {len(d.stages) + 1} (motor->stage 1, ..., last stage->machine)"
+                )
+        else:
+            if d.stages or d.shafts:
+                raise ScenarioError(
+                    f"design.stages / design.shafts belong to scene 'train', not {self.meta.scene!r}"
+                )
+            for name in ("pinion", "wheel"):
+                if getattr(d, name) is None:
+                    raise ScenarioError(f"design.{name} is required for scene {self.meta.scene!r}")
+            if self.meta.scene == "one-stage":
+                for name in ("coupling", "output_shaft"):
+                    if getattr(d, name) is None:
+                        raise ScenarioError(f"design.{name} is required for scene 'one-stage'")
+
+    def _resolve_geometry(self) -> None:
+        """Fill in what each mesh's [geometry] table fixes (gearbody.model.resolve)."""
+        from .resolve import resolve_iso_stiffness, resolve_stage_geometry
+
+        d, train = self.design, self.meta.scene == "train"
+        if train:
+            stages = []
+            for k, st in enumerate(d.stages):
+                p, w, m = resolve_stage_geometry(st.pinion, st.wheel, st.mesh, f"design.stages[{k}].mesh.")
+                stages.append(dataclasses.replace(st, pinion=p, wheel=w, mesh=m))
+            object.__setattr__(self, "design", dataclasses.replace(d, stages=tuple(stages)))
+        else:
+            p, w, m = resolve_stage_geometry(d.pinion, d.wheel, d.mesh, "design.mesh.")
+            object.__setattr__(self, "design", dataclasses.replace(d, pinion=p, wheel=w, mesh=m))
+        d = self.design
+        for k, st in enumerate(self.stages):
+            where = f"design.stages[{k}].mesh." if train else "design.mesh."
+            if st.mesh.stiffness_profile == "iso-6336-b":
+                mesh = resolve_iso_stiffness(
+                    st.mesh, st.pinion.teeth, st.wheel.teeth, self.stage_rated_force_N(k), where
+                )
+                if train:
+                    stages = list(d.stages)
+                    stages[k] = dataclasses.replace(st, mesh=mesh)
+                    d = dataclasses.replace(d, stages=tuple(stages))
+                else:
+                    d = dataclasses.replace(d, mesh=mesh)
+                object.__setattr__(self, "design", d)
+            where_t = f"design.stages[{k}]." if train else "condition."
+            for tooth in st.damaged_teeth:
+                if tooth.has_geometric_damage and st.mesh.stiffness_profile != "potential-energy":
+                    raise ScenarioError(
+                        f"{where_t}damaged_teeth: {tooth.gear} tooth {tooth.tooth} has a crack, breakage or "
+                        f"spall; these need {where}stiffness_profile = 'potential-energy' (got "
+                        f"{st.mesh.stiffness_profile!r})"
+                    )
+            if st.mesh.stiffness_profile == "potential-energy" and any(
+                t.has_geometric_damage for t in st.damaged_teeth
+            ):
+                from ..physics.mesh_stiffness import stage_pair_table
+
+                try:
+                    stage_pair_table(st)
+                except ValueError as exc:
+                    raise ScenarioError(f"{where_t}damaged_teeth: {exc}") from None
 
     # -- derived quantities used everywhere ------------------------------------------------
     @property

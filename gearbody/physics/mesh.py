@@ -41,11 +41,14 @@ I_ARM1, I_ARM2, I_PB, I_A = 12, 13, 14, 15
 I_NTAB = 16
 I_ECC_P, I_ECC_P_PHASE, I_ECC_W, I_ECC_W_PHASE = 17, 18, 19, 20  # run-out amplitudes (m), phases (rad)
 I_WIDTH = 21  # transition width w, fraction of the mesh period (0: sharp law)
+I_PAIR_N = 22  # points N of the pair stiffness table ("pairs" profile), 0 otherwise
 I_HEADER = 24
 # after the header: e_i (z1), pinion factors (z1), wheel factors (z2), table phases (n), table k (n),
-# pit depth / start phase / end phase per pinion tooth (3 z1), then per wheel tooth (3 z2)
+# pit depth / start phase / end phase per pinion tooth (3 z1), then per wheel tooth (3 z2);
+# "pairs" profile: healthy pair table (N), ratio-table slot per pinion tooth (z1) and per wheel tooth
+# (z2) (0 = none, s = the s-th ratio table), ratio tables (N each)
 
-PROFILE_CONTACT_RATIO, PROFILE_TABLE = 0.0, 1.0
+PROFILE_CONTACT_RATIO, PROFILE_TABLE, PROFILE_PAIRS = 0.0, 1.0, 2.0
 
 
 def pack_mesh_parameters(
@@ -73,8 +76,14 @@ def pack_mesh_parameters(
     pinion_pits: np.ndarray | None = None,
     wheel_pits: np.ndarray | None = None,
     transition_width: float = 0.0,
+    pair_stiffness_N_per_m: np.ndarray | None = None,
+    pair_ratios: dict[tuple[str, int], np.ndarray] | None = None,
 ) -> np.ndarray:
-    """Pack everything the mesh law needs into one float64 array (see module docstring)."""
+    """Pack everything the mesh law needs into one float64 array (see module docstring).
+
+    ``pair_stiffness_N_per_m``: healthy pair stiffness on the grid ``q_m = -h + m (1 + 2h)/(N - 1)``
+    (the "pairs" profile, :func:`pair_stiffness_sum`); ``pair_ratios``: ``(gear, tooth) -> ratio table``
+    on the same grid for damaged teeth."""
     f = np.ones(z1) if pinion_factors is None else np.asarray(pinion_factors, float)
     g = np.ones(z2) if wheel_factors is None else np.asarray(wheel_factors, float)
     tp = np.zeros(0) if table_phase is None else np.asarray(table_phase, float)
@@ -91,6 +100,21 @@ def pack_mesh_parameters(
     head = np.zeros(I_HEADER)
     head[I_R1], head[I_R2], head[I_Z1], head[I_Z2] = r1_m, r2_m, z1, z2
     head[I_KIND] = PROFILE_TABLE if tp.size else PROFILE_CONTACT_RATIO
+    pairs: list[np.ndarray] = []
+    if pair_stiffness_N_per_m is not None:
+        kp = np.asarray(pair_stiffness_N_per_m, float)
+        if tp.size or kp.ndim != 1 or kp.size < 2:
+            raise ValueError("a pair stiffness table needs >= 2 points and no phase table")
+        head[I_KIND], head[I_PAIR_N] = PROFILE_PAIRS, kp.size
+        slots = {"pinion": np.zeros(z1), "wheel": np.zeros(z2)}
+        tables = []
+        for (gear, tooth), ratio in sorted((pair_ratios or {}).items()):
+            ratio = np.asarray(ratio, float)
+            if ratio.shape != kp.shape:
+                raise ValueError("pair ratio tables must have the pair table's points")
+            tables.append(ratio)
+            slots[gear][tooth] = len(tables)
+        pairs = [kp, slots["pinion"], slots["wheel"], *tables]
     head[I_KSINGLE], head[I_KDOUBLE] = stiffness_single_N_per_m, stiffness_double_N_per_m
     head[I_HALF_DOUBLE] = 0.5 * (contact_ratio - 1.0)
     head[I_CZ], head[I_LU], head[I_MU], head[I_PITCH] = (
@@ -107,7 +131,7 @@ def pack_mesh_parameters(
     head[I_ECC_P], head[I_ECC_W] = runout_m
     head[I_ECC_P_PHASE], head[I_ECC_W_PHASE] = runout_phase_rad
     head[I_WIDTH] = transition_width
-    return np.concatenate([head, e, f, g, tp, tk, pits_p.T.ravel(), pits_w.T.ravel()])
+    return np.concatenate([head, e, f, g, tp, tk, pits_p.T.ravel(), pits_w.T.ravel(), *pairs])
 
 
 def mesh_parameters_from_scenario(scenario, stage: int = 0, *, friction: bool = True) -> np.ndarray:
@@ -119,6 +143,11 @@ def mesh_parameters_from_scenario(scenario, stage: int = 0, *, friction: bool = 
     for tooth in st.damaged_teeth:
         (f if tooth.gear == "pinion" else g)[tooth.tooth] *= tooth.stiffness_factor
     table = mesh.stiffness_profile == "table"
+    pair_table = None
+    if mesh.stiffness_profile == "potential-energy":
+        from .mesh_stiffness import stage_pair_table
+
+        pair_table = stage_pair_table(st)
     runout, runout_phase = [0.0, 0.0], [0.0, 0.0]
     for ecc in st.eccentricity:
         k = 0 if ecc.gear == "pinion" else 1
@@ -150,6 +179,8 @@ def mesh_parameters_from_scenario(scenario, stage: int = 0, *, friction: bool = 
         pinion_pits=pits["pinion"],
         wheel_pits=pits["wheel"],
         transition_width=mesh.transition_width,
+        pair_stiffness_N_per_m=None if pair_table is None else pair_table.stiffness_N_per_m,
+        pair_ratios=None if pair_table is None else pair_table.ratios,
     )
 
 
@@ -166,13 +197,16 @@ def smooth_step(x: float) -> float:
 
 @njit(cache=True)
 def stiffness_at_phase(p: float, P: np.ndarray) -> float:
-    """k_z(p) of a healthy pair, N/m: single/double contact from the contact ratio, or a periodic table."""
+    """k_z(p) of healthy teeth, N/m: single/double contact from the contact ratio, a periodic table, or
+    the sum of the pairs in contact ("pairs")."""
     if P[I_KIND] == PROFILE_CONTACT_RATIO:
         h, w = P[I_HALF_DOUBLE], P[I_WIDTH]
         if w > 0.0 and h > 0.0:
             share = 1.0 - smooth_step((p - h) / w) + smooth_step((p - 1.0 + h) / w)
             return P[I_KSINGLE] + (P[I_KDOUBLE] - P[I_KSINGLE]) * share
         return P[I_KDOUBLE] if (p < h or p >= 1.0 - h) else P[I_KSINGLE]
+    if P[I_KIND] == PROFILE_PAIRS:
+        return _pairs_sum(p, -1, -1, P)[1]
     z1, z2, n = int(P[I_Z1]), int(P[I_Z2]), int(P[I_NTAB])
     o = I_HEADER + 2 * z1 + z2
     ph = P[o : o + n]
@@ -185,6 +219,78 @@ def stiffness_at_phase(p: float, P: np.ndarray) -> float:
         m = np.searchsorted(ph, p, side="right") - 1
         x0, k0, x1, k1 = ph[m], kk[m], ph[m + 1], kk[m + 1]
     return k0 + (k1 - k0) * (p - x0) / (x1 - x0)
+
+
+@njit(cache=True)
+def _pairs_offset(P: np.ndarray) -> int:
+    """Start of the pair table in P (after the pits)."""
+    z1, z2 = int(P[I_Z1]), int(P[I_Z2])
+    return I_HEADER + 2 * z1 + z2 + 2 * int(P[I_NTAB]) + 3 * z1 + 3 * z2
+
+
+@njit(cache=True)
+def _pair_table_value(q: float, table: int, P: np.ndarray) -> float:
+    """Linear interpolation of pair table ``table`` (0 = healthy k, s >= 1 = ratio table s) at own phase
+    q on the grid -h .. 1 + h, held at its end values outside."""
+    n = int(P[I_PAIR_N])
+    h = P[I_HALF_DOUBLE]
+    x = (q + h) * (n - 1) / (1.0 + 2.0 * h)
+    if x <= 0.0:
+        m, f = 0, 0.0
+    elif x >= n - 1:
+        m, f = n - 2, 1.0
+    else:
+        m = int(x)
+        f = x - m
+    o = _pairs_offset(P)
+    if table > 0:
+        o += n + int(P[I_Z1]) + int(P[I_Z2]) + (table - 1) * n
+    return P[o + m] + f * (P[o + m + 1] - P[o + m])
+
+
+@njit(cache=True)
+def _contact_weight(q: float, P: np.ndarray) -> float:
+    """1 while a pair at own phase q is in contact (-h <= q < 1 + h), 0 outside; smooth steps of width w."""
+    h, w = P[I_HALF_DOUBLE], P[I_WIDTH]
+    if w > 0.0:
+        return smooth_step((q + h) / w) * (1.0 - smooth_step((q - 1.0 - h) / w))
+    return 1.0 if -h <= q < 1.0 + h else 0.0
+
+
+@njit(cache=True)
+def _pairs_sum(p: float, i: int, j: int, P: np.ndarray):
+    """Sum of the pairs in contact at mesh phase p: the period's pair (teeth i, j, own phase p), the
+    outgoing (i - 1, j - 1, at p + 1) and the incoming (i + 1, j + 1, at p - 1), each weighted by its
+    contact and by its teeth's factors f g and damage ratios. Returns (k, k_healthy), N/m; k_healthy
+    with all factors 1 (i < 0: only k_healthy is meaningful, the teeth are not looked up)."""
+    z1, z2 = int(P[I_Z1]), int(P[I_Z2])
+    slots = _pairs_offset(P) + int(P[I_PAIR_N])
+    k = 0.0
+    k_healthy = 0.0
+    for o in (-1, 0, 1):
+        q = p - o
+        c = _contact_weight(q, P)
+        if c == 0.0:
+            continue
+        kq = c * _pair_table_value(q, 0, P)
+        k_healthy += kq
+        if i >= 0:
+            io, jo = (i + o) % z1, (j + o) % z2
+            kq *= tooth_pair_factor(io, jo, P)
+            sp, sw = int(P[slots + io]), int(P[slots + z1 + jo])
+            if sp > 0:
+                kq *= _pair_table_value(q, sp, P)
+            if sw > 0:
+                kq *= _pair_table_value(q, sw, P)
+        k += kq
+    return k, k_healthy
+
+
+@njit(cache=True)
+def teeth_in_mesh(pinion_angle_rad: float, P: np.ndarray):
+    """Pinion tooth i and wheel tooth j of the period's pair at a pinion angle."""
+    n = math.floor(pinion_angle_rad * P[I_Z1] / (2.0 * math.pi))
+    return int(n % int(P[I_Z1])), int(n % int(P[I_Z2]))
 
 
 @njit(cache=True)
@@ -273,6 +379,26 @@ def _error_at(pinion_angle_rad: float, p: float, i: int, j: int, P: np.ndarray) 
 
 
 @njit(cache=True)
+def _stiffness_and_factor(pinion_angle_rad: float, p: float, factor: float, P: np.ndarray):
+    """Effective k (N/m) and damping factor at mesh phase p, given the period's tooth factor f_i g_j."""
+    if P[I_KIND] == PROFILE_PAIRS:  # each pair with its own teeth's factors and damage over its contact
+        i, j = teeth_in_mesh(pinion_angle_rad, P)
+        k, k_healthy = _pairs_sum(p, i, j, P)
+        return k, k / k_healthy  # the damping factor, as f_i g_j in the other profiles
+    return stiffness_at_phase(p, P) * factor, factor
+
+
+@njit(cache=True)
+def effective_stiffness_series(pinion_angle_rad: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """k_z (N/m) the law uses at each pinion angle: profile, tooth factors and tooth damage included."""
+    k = np.empty(pinion_angle_rad.size)
+    for m in range(pinion_angle_rad.size):
+        p, factor, _ = pair_in_mesh(pinion_angle_rad[m], P)
+        k[m] = _stiffness_and_factor(pinion_angle_rad[m], p, factor, P)[0]
+    return k
+
+
+@njit(cache=True)
 def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float, P: np.ndarray):
     """Normal mesh force F (N, elastic + damping), friction force T (N) and arms rho_1, rho_2 (m).
 
@@ -280,7 +406,7 @@ def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float,
     along the line of action (r1 phi_p - r2 phi_w, plus centre motions in lateral models).
     """
     p, factor, E = pair_in_mesh(pinion_angle_rad, P)
-    k = stiffness_at_phase(p, P) * factor
+    k, factor = _stiffness_and_factor(pinion_angle_rad, p, factor, P)
     d = delta_m + E
     lu = P[I_LU]
     if d > lu:
@@ -370,7 +496,7 @@ def mesh_breakpoint_phases(P: np.ndarray) -> np.ndarray:
     if P[I_WIDTH] > 0.0:
         return np.zeros(0)
     phases = [0.0]
-    if P[I_KIND] == PROFILE_CONTACT_RATIO and 0.0 < P[I_HALF_DOUBLE] < 0.5:
+    if P[I_KIND] != PROFILE_TABLE and 0.0 < P[I_HALF_DOUBLE] < 0.5:
         phases += [P[I_HALF_DOUBLE], 1.0 - P[I_HALF_DOUBLE]]
     if P[I_MU] != 0.0:
         phases.append(P[I_PITCH] % 1.0)
@@ -388,6 +514,9 @@ def mean_stiffness_N_per_m(P: np.ndarray) -> float:
     if P[I_KIND] == PROFILE_CONTACT_RATIO:
         h2 = 2.0 * P[I_HALF_DOUBLE]  # eps - 1
         return float(h2 * P[I_KDOUBLE] + (1.0 - h2) * P[I_KSINGLE])
+    if P[I_KIND] == PROFILE_PAIRS:  # piecewise linear between grid points: a fine midpoint rule
+        p = (np.arange(20000) + 0.5) / 20000
+        return float(np.mean([stiffness_at_phase(x, P) for x in p]))
     z1, z2, n = int(P[I_Z1]), int(P[I_Z2]), int(P[I_NTAB])
     o = I_HEADER + 2 * z1 + z2
     ph = np.append(P[o : o + n], P[o] + 1.0)

@@ -1,0 +1,155 @@
+"""Resolve meshes stated by gear geometry into the numbers the mesh law uses (docs/scenario.md, "Gear
+geometry"): base radii, face widths, contact ratio, pitch-point phase, working pressure angle, backlash
+and the single/double stiffness. Values the user also gave must agree with the computed ones (a dumped
+scenario reloads unchanged); otherwise the key is refused, naming both values.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from .params import ScenarioError
+
+_REL_TOL = 1e-9
+
+
+def _agree(where: str, key: str, given, computed: float) -> float:
+    if given is not None and not math.isclose(given, computed, rel_tol=_REL_TOL, abs_tol=1e-15):
+        raise ScenarioError(
+            f"{where}{key} = {given:.10g}: the gear geometry gives {computed:.10g}; leave the key out (it is "
+            "computed from [geometry]) or remove the geometry"
+        )
+    return computed
+
+
+def pair_geometry(mesh, teeth_pinion: int, teeth_wheel: int, where: str = "design.mesh."):
+    """:class:`~gearbody.physics.gear_geometry.GearPairGeometry` of a mesh's [geometry] table."""
+    from ..physics.gear_geometry import gear_pair_geometry
+
+    g = mesh.geometry
+    try:
+        return gear_pair_geometry(
+            module_m=g.module_mm * 1e-3,
+            teeth_pinion=teeth_pinion,
+            teeth_wheel=teeth_wheel,
+            face_width_m=g.face_width_mm * 1e-3,
+            pressure_angle_deg=g.pressure_angle_deg,
+            helix_angle_deg=g.helix_angle_deg,
+            profile_shift_pinion=g.profile_shift_pinion,
+            profile_shift_wheel=g.profile_shift_wheel,
+            addendum_coefficient=g.addendum_coefficient,
+            dedendum_coefficient=g.dedendum_coefficient,
+            centre_distance_m=None if g.centre_distance_mm is None else g.centre_distance_mm * 1e-3,
+        )
+    except ScenarioError as exc:
+        raise ScenarioError(f"{where}geometry: {exc}") from None
+
+
+def resolve_stage_geometry(pinion, wheel, mesh, where: str):
+    """(pinion, wheel, mesh) with everything the geometry fixes filled in; stiffness left for later."""
+    if mesh.geometry is None:
+        for name, gear in (("pinion", pinion), ("wheel", wheel)):
+            if gear.base_radius_m is None:
+                raise ScenarioError(
+                    f"{where.replace('mesh.', '')}{name}.base_radius_m is required (or give the mesh a "
+                    "[geometry] table with module_mm and face_width_mm)"
+                )
+        return pinion, wheel, mesh
+    g = mesh.geometry
+    geo = pair_geometry(mesh, pinion.teeth, wheel.teeth, where)
+    if g.helix_angle_deg > 0 and mesh.stiffness_profile != "iso-6336-b":
+        raise ScenarioError(
+            f"{where}geometry.helix_angle_deg = {g.helix_angle_deg:g}: the potential-energy stiffness and "
+            "hand-given profiles are for spur gears; use stiffness_profile = 'iso-6336-b' for a helical pair"
+        )
+    eps = geo.transverse_contact_ratio
+    if eps >= 2.0:
+        raise ScenarioError(
+            f"{where}geometry: transverse contact ratio {eps:.5f} >= 2; the mesh law of gearbody has at most "
+            "two pairs in contact (allowed: 1 <= eps_alpha < 2)"
+        )
+    pitch = geo.pitch_point_phase
+    if not 0.0 <= pitch <= 1.0:
+        raise ScenarioError(
+            f"{where}geometry: the pitch point lies outside the period's pair's mesh period (phase "
+            f"{pitch:.4f}, allowed [0, 1]); balance the addenda or the profile shifts"
+        )
+    out_gears = []
+    for name, gear, rb in (
+        ("pinion", pinion, geo.base_radius_pinion_m),
+        ("wheel", wheel, geo.base_radius_wheel_m),
+    ):
+        gw = where.replace("mesh.", "") + name + "."
+        out_gears.append(
+            dataclasses.replace(
+                gear,
+                base_radius_m=_agree(gw, "base_radius_m", gear.base_radius_m, rb),
+                face_width_m=_agree(gw, "face_width_m", gear.face_width_m, geo.face_width_m),
+            )
+        )
+    derived = {
+        "contact_ratio": _agree(where, "contact_ratio", mesh.contact_ratio, eps),
+        "pitch_point_phase": _agree(where, "pitch_point_phase", mesh.pitch_point_phase, pitch),
+        "pressure_angle_deg": _agree(
+            where, "pressure_angle_deg", mesh.pressure_angle_deg, math.degrees(geo.working_pressure_angle_rad)
+        ),
+    }
+    allowances = (g.thickness_allowance_pinion_um, g.thickness_allowance_wheel_um)
+    if g.sets_backlash:
+        from ..physics.gear_geometry import backlash_half_width_m, normal_backlash_m
+
+        j_bn = normal_backlash_m(
+            geo,
+            thickness_allowance_pinion_m=(allowances[0] or 0.0) * 1e-6,
+            thickness_allowance_wheel_m=(allowances[1] or 0.0) * 1e-6,
+            centre_distance_deviation_m=g.centre_distance_deviation_um * 1e-6,
+        )
+        if j_bn < 0:
+            raise ScenarioError(
+                f"{where}geometry: the allowances give a negative backlash ({j_bn * 1e6:.3g} µm): "
+                "the teeth jam"
+            )
+        derived["backlash_um"] = _agree(
+            where, "backlash_um", mesh.backlash_um, backlash_half_width_m(geo, j_bn) * 1e6
+        )
+    if mesh.stiffness_profile == "potential-energy":
+        from ..physics.mesh_stiffness import pair_stiffness_table
+
+        try:
+            table = pair_stiffness_table(g, pinion.teeth, wheel.teeth)
+        except ValueError as exc:
+            raise ScenarioError(f"{where}{exc}") from None
+        single, double = table.zone_means_N_per_m()
+        derived["stiffness_single_N_per_m"] = _agree(
+            where, "stiffness_single_N_per_m", mesh.stiffness_single_N_per_m, single
+        )
+        derived["stiffness_double_N_per_m"] = _agree(
+            where, "stiffness_double_N_per_m", mesh.stiffness_double_N_per_m, double
+        )
+    elif mesh.stiffness_profile in ("contact-ratio", "table"):
+        from .scenario import MESH_DEFAULTS
+
+        for key in ("stiffness_single_N_per_m", "stiffness_double_N_per_m"):
+            if getattr(mesh, key) is None:
+                derived[key] = MESH_DEFAULTS[key]
+    return out_gears[0], out_gears[1], dataclasses.replace(mesh, **derived)
+
+
+def resolve_iso_stiffness(mesh, teeth_pinion: int, teeth_wheel: int, rated_force_N: float, where: str):
+    """Mesh with the ISO 6336-1 method B single/double stiffness; line load F_t / b with the rated
+    tangential force at the reference circle, F_t = F_rated cos(alpha_t) (F_rated: line of action)."""
+    from ..physics.stiffness_iso import iso_mesh_stiffness_profile
+
+    geo = pair_geometry(mesh, teeth_pinion, teeth_wheel, where)
+    line_load = rated_force_N * math.cos(geo.transverse_pressure_angle_rad) / mesh.geometry.face_width_mm
+    single, double = iso_mesh_stiffness_profile(geo, line_load_N_per_mm=line_load)
+    return dataclasses.replace(
+        mesh,
+        stiffness_single_N_per_m=_agree(
+            where, "stiffness_single_N_per_m", mesh.stiffness_single_N_per_m, single
+        ),
+        stiffness_double_N_per_m=_agree(
+            where, "stiffness_double_N_per_m", mesh.stiffness_double_N_per_m, double
+        ),
+    )
