@@ -55,7 +55,8 @@ def main() -> None:
         rows.append((name, best / args.calls * 1e9))
     base = rows[0][1]
     lines = [
-        f"## mesh law per call, {args.calls} calls, best of {args.repeat} ({date.today()}, {platform.machine()})",
+        f"## mesh law per call, {args.calls} calls, best of {args.repeat} "
+        f"({date.today()}, {platform.machine()})",
         "",
         "| stiffness profile | ns per call | ratio to contact-ratio |",
         "|---|---|---|",
