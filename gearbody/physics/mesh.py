@@ -514,9 +514,11 @@ def mean_stiffness_N_per_m(P: np.ndarray) -> float:
     if P[I_KIND] == PROFILE_CONTACT_RATIO:
         h2 = 2.0 * P[I_HALF_DOUBLE]  # eps - 1
         return float(h2 * P[I_KDOUBLE] + (1.0 - h2) * P[I_KSINGLE])
-    if P[I_KIND] == PROFILE_PAIRS:  # piecewise linear between grid points: a fine midpoint rule
-        p = (np.arange(20000) + 0.5) / 20000
-        return float(np.mean([stiffness_at_phase(x, P) for x in p]))
+    if P[I_KIND] == PROFILE_PAIRS:  # each pair contributes its table's integral over its contact
+        n, h = int(P[I_PAIR_N]), P[I_HALF_DOUBLE]
+        o = _pairs_offset(P)
+        k = P[o : o + n]
+        return float(0.5 * np.sum(k[1:] + k[:-1]) * (1.0 + 2.0 * h) / (n - 1))
     z1, z2, n = int(P[I_Z1]), int(P[I_Z2]), int(P[I_NTAB])
     o = I_HEADER + 2 * z1 + z2
     ph = np.append(P[o : o + n], P[o] + 1.0)

@@ -52,10 +52,11 @@ class PairStiffnessTable:
         h = self.half_double
         return np.where((q >= -h) & (q < 1.0 + h), k, 0.0)
 
-    def mean_stiffness_N_per_m(self, n: int = 4000) -> float:
-        """Mean of the healthy total (summed pairs) over one mesh period."""
-        p = (np.arange(n) + 0.5) / n
-        return float(np.mean(sum(self.pair_stiffness(p - o) for o in (-1, 0, 1))))
+    def mean_stiffness_N_per_m(self) -> float:
+        """Mean of the healthy total (summed pairs) over one mesh period: the integral of one pair's
+        (piecewise-linear) stiffness over its contact, per period."""
+        k = self.stiffness_N_per_m
+        return float(0.5 * np.sum(k[1:] + k[:-1]) * (1.0 + 2.0 * self.half_double) / (k.size - 1))
 
     def zone_means_N_per_m(self, n: int = 4000) -> tuple[float, float]:
         """Mean healthy total stiffness in the single- and in the double-contact zones."""
