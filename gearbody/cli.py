@@ -334,13 +334,8 @@ def cmd_modes(args) -> int:
 
 
 def cmd_mesh(args) -> int:
-    from .mesh_report import (
-        damage_windows,
-        plot_stage,
-        static_transmission_error,
-        stiffness_cycle,
-        summary_text,
-    )
+    from .mesh_plots import plot_stage
+    from .mesh_report import damage_windows, static_transmission_error, stiffness_cycle, summary_text
 
     scenario = _load(args.scene, args.overrides)
     count = len(scenario.stages)

@@ -2,9 +2,9 @@
 cycle (healthy, and around each damaged tooth) and the static transmission error under load.
 
 Engine-free (no Exudyn): everything is evaluated with the mesh law of :mod:`gearbody.physics.mesh` and the
-scenario's packed parameters, so the curves are exactly what the solver uses. Data functions return
-plain dataclasses and arrays (testable); :func:`plot_stage` writes one PNG per stage (matplotlib Agg
-canvas, as :mod:`gearbody.plots`). docs/mesh.md describes the output.
+scenario's packed parameters, so the curves are exactly what the solver uses. The functions here return
+plain dataclasses, arrays and text (testable); :func:`gearbody.mesh_plots.plot_stage` draws them, one PNG
+per stage. docs/mesh.md describes the output.
 
 Coordinates: ``u = phi_p z1 / (2 pi)`` counts mesh periods along the pinion angle phi_p; period
 ``n = floor(u)`` is the pair of pinion tooth ``n mod z1`` and wheel tooth ``n mod z2``, at mesh phase
@@ -15,8 +15,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
-from pathlib import Path
 
 import numpy as np
 
@@ -30,7 +28,6 @@ __all__ = [
     "damage_windows",
     "format_table",
     "geometry_table",
-    "plot_stage",
     "stage_label",
     "static_transmission_error",
     "stiffness_cycle",
@@ -39,8 +36,6 @@ __all__ = [
 ]
 
 Row = tuple[str, object, str]  # (name, value, unit); value None: a section heading
-PathLike = str | os.PathLike[str]
-MAX_WINDOWS_PLOTTED = 4
 
 
 # -- parameters ------------------------------------------------------------------------------------
@@ -71,16 +66,28 @@ def _healthy_scenario(scenario, stage: int):
     )
 
 
-def _check_stage(scenario, stage: int) -> None:
+def _stage(scenario, stage: int):
+    """The scenario's stage ``stage`` (0-based); IndexError if there is none."""
     n = len(scenario.stages)
     if not (isinstance(stage, int) and 0 <= stage < n):
         raise IndexError(f"stage = {stage!r}: the scenario has {n} stage(s) (0-based index 0..{n - 1})")
+    return scenario.stages[stage]
 
 
 def _parameters(scenario, stage: int, healthy: bool = False) -> np.ndarray:
     """Packed mesh parameters (friction off: it does not enter k_z, E or the static TE)."""
     source = _healthy_scenario(scenario, stage) if healthy else scenario
     return _mesh.mesh_parameters_from_scenario(source, stage, friction=False)
+
+
+def _parameter_pair(scenario, stage: int) -> tuple[np.ndarray, np.ndarray]:
+    """Packed mesh parameters as given and with perfect gears (:func:`_healthy_scenario`)."""
+    return _parameters(scenario, stage), _parameters(scenario, stage, healthy=True)
+
+
+def _half_double(mesh) -> float:
+    """h = (eps_alpha - 1)/2: double contact for mesh phase p < h and p >= 1 - h."""
+    return 0.5 * (mesh.contact_ratio - 1.0)
 
 
 def _angles(periods: np.ndarray, z1: int) -> np.ndarray:
@@ -103,20 +110,19 @@ def geometry_table(scenario, stage: int = 0) -> list[Row]:
     contact ratios, backlash and the stiffness (profile, single/double/mean k_z, ISO 6336-1 method B,
     potential-energy mean). Section headings are rows with value None. A hand-given mesh (no
     [geometry]) lists what is known and says that the geometry is not given."""
-    _check_stage(scenario, stage)
-    st = scenario.stages[stage]
+    from .model.resolve import pair_geometry
+
+    st = _stage(scenario, stage)
     mesh, z1, z2 = st.mesh, st.pinion.teeth, st.wheel.teeth
+    geo = None if mesh.geometry is None else pair_geometry(mesh, z1, z2)
     rows: list[Row] = [
         ("gears", None, ""),
         ("teeth z1 (pinion)", z1, ""),
         ("teeth z2 (wheel)", z2, ""),
         ("gear ratio z2/z1", z2 / z1, ""),
     ]
-    if mesh.geometry is None:
-        rows += _hand_given_rows(st)
-    else:
-        rows += _geometry_rows(st)
-    rows += _stiffness_rows(scenario, stage)
+    rows += _hand_given_rows(st) if geo is None else _geometry_rows(st, geo)
+    rows += _stiffness_rows(scenario, stage, geo)
     return rows
 
 
@@ -141,11 +147,8 @@ def _hand_given_rows(st) -> list[Row]:
     ]
 
 
-def _geometry_rows(st) -> list[Row]:
-    from .model.resolve import pair_geometry
-
+def _geometry_rows(st, geo) -> list[Row]:
     g = st.mesh.geometry
-    geo = pair_geometry(st.mesh, st.pinion.teeth, st.wheel.teeth)
     deg = math.degrees
     rows: list[Row] = [
         ("normal module m_n", g.module_mm, "mm"),
@@ -196,21 +199,21 @@ def _geometry_rows(st) -> list[Row]:
     return rows
 
 
-def _cycle_stats(P: np.ndarray, z1: int, n: int = 20000) -> tuple[float, float, float]:
-    """(mean, min, max) of the healthy k_z over one period (midpoint rule, as mean_stiffness_N_per_m)."""
+def _cycle_range(P: np.ndarray, z1: int, n: int = 20000) -> tuple[float, float]:
+    """(min, max) of the healthy k_z over one period, sampled at ``n`` period midpoints."""
     u = (np.arange(n) + 0.5) / n
     k = _mesh.effective_stiffness_series(_angles(u, z1), P)
-    return float(k.mean()), float(k.min()), float(k.max())
+    return float(k.min()), float(k.max())
 
 
-def _stiffness_rows(scenario, stage: int) -> list[Row]:
+def _stiffness_rows(scenario, stage: int, geo) -> list[Row]:
+    """Stiffness rows; ``geo`` is the stage's pair geometry (None for a hand-given mesh)."""
     st = scenario.stages[stage]
     mesh = st.mesh
     P = _parameters(scenario, stage, healthy=True)
     k_mean = _mesh.mean_stiffness_N_per_m(P)
-    _, k_min, k_max = _cycle_stats(P, st.pinion.teeth)
+    k_min, k_max = _cycle_range(P, st.pinion.teeth)
     force = scenario.stage_rated_force_N(stage)
-    pe = mesh.stiffness_profile == "potential-energy"
     rows: list[Row] = [
         ("stiffness (healthy teeth)", None, ""),
         ("stiffness profile", mesh.stiffness_profile, ""),
@@ -218,11 +221,10 @@ def _stiffness_rows(scenario, stage: int) -> list[Row]:
     if mesh.stiffness_profile == "table":
         rows.append(("k_z table points", len(mesh.table_phase), ""))
     else:
-        single = "k_z single contact" + (" (zone mean)" if pe else "")
-        double = "k_z double contact" + (" (zone mean)" if pe else "")
+        zone = " (zone mean)" if mesh.stiffness_profile == "potential-energy" else ""
         rows += [
-            (single, mesh.stiffness_single_N_per_m, "N/m"),
-            (double, mesh.stiffness_double_N_per_m, "N/m"),
+            ("k_z single contact" + zone, mesh.stiffness_single_N_per_m, "N/m"),
+            ("k_z double contact" + zone, mesh.stiffness_double_N_per_m, "N/m"),
         ]
     rows += [
         ("k_z mean over a mesh period", k_mean, "N/m"),
@@ -231,13 +233,11 @@ def _stiffness_rows(scenario, stage: int) -> list[Row]:
         ("k_z ripple (max - min)/mean", (k_max - k_min) / k_mean * 100.0, "%"),
         ("rated force F_rated (line of action)", force, "N"),
     ]
-    g = mesh.geometry
-    if g is None:
+    if geo is None:
         return rows
-    from .model.resolve import pair_geometry
     from .physics.stiffness_iso import iso_stiffness
 
-    geo = pair_geometry(mesh, st.pinion.teeth, st.wheel.teeth)
+    g = mesh.geometry
     line_load = force * math.cos(geo.transverse_pressure_angle_rad) / g.face_width_mm
     iso = iso_stiffness(geo, line_load_N_per_mm=line_load)
     rows += [
@@ -314,15 +314,14 @@ def stiffness_cycle(
     scenario, stage: int = 0, periods: int = 2, points_per_period: int = 400
 ) -> StiffnessCycle:
     """k_z of healthy teeth over ``periods`` mesh periods, as the solver evaluates it."""
-    _check_stage(scenario, stage)
-    st = scenario.stages[stage]
+    st = _stage(scenario, stage)
     P = _parameters(scenario, stage, healthy=True)
     u = np.arange(periods * points_per_period + 1) / points_per_period
     u[-1] -= 1e-9  # stay inside the last period
     return StiffnessCycle(
         periods=u,
         stiffness_N_per_m=_mesh.effective_stiffness_series(_angles(u, st.pinion.teeth), P),
-        half_double=0.5 * (st.mesh.contact_ratio - 1.0),
+        half_double=_half_double(st.mesh),
         pitch_point_phase=st.mesh.pitch_point_phase,
         mean_N_per_m=_mesh.mean_stiffness_N_per_m(P),
         profile=st.mesh.stiffness_profile,
@@ -383,11 +382,10 @@ def damage_windows(
 ) -> list[DamageWindow]:
     """One window per damaged tooth of the stage (stiffness factor < 1 or crack/breakage/spall): k_z
     over periods ``n0 - before .. n0 + after`` around the first period n0 of that tooth's pair."""
-    _check_stage(scenario, stage)
-    st = scenario.stages[stage]
+    st = _stage(scenario, stage)
     z1, z2 = st.pinion.teeth, st.wheel.teeth
-    P, P0 = _parameters(scenario, stage), _parameters(scenario, stage, healthy=True)
-    h = 0.5 * (st.mesh.contact_ratio - 1.0)
+    P, P0 = _parameter_pair(scenario, stage)
+    h = _half_double(st.mesh)
     whole_contact = st.mesh.stiffness_profile == "potential-energy"
     merged: dict[tuple[str, int], list] = {}
     for tooth in st.damaged_teeth:
@@ -449,12 +447,11 @@ def static_transmission_error(
 ) -> StaticTransmissionError:
     """Static TE at ``load_fraction`` of the stage's rated force over one pinion turn (or the turns that
     reach the damaged or pitted wheel teeth), µm: as given and with perfect gears."""
-    _check_stage(scenario, stage)
+    st = _stage(scenario, stage)
     if not (math.isfinite(load_fraction) and load_fraction >= 0.0):
         raise ValueError(f"load_fraction = {load_fraction!r}: must be finite and >= 0")
-    st = scenario.stages[stage]
     z1 = st.pinion.teeth
-    P, P0 = _parameters(scenario, stage), _parameters(scenario, stage, healthy=True)
+    P, P0 = _parameter_pair(scenario, stage)
     turns = _turns(st)
     u = (np.arange(turns * z1 * points_per_period) + 0.5) / points_per_period
     phi = _angles(u, z1)
@@ -478,6 +475,24 @@ def static_transmission_error(
 
 
 # -- text summary ----------------------------------------------------------------------------------
+def _stage_data(scenario, stage: int, load_fraction: float, cycle, windows, te):
+    """(cycle, windows, te) of a stage for :func:`summary_text` and ``plot_stage``: those passed in (not
+    None), the others computed with default sampling."""
+    return (
+        stiffness_cycle(scenario, stage) if cycle is None else cycle,
+        damage_windows(scenario, stage) if windows is None else windows,
+        static_transmission_error(scenario, stage, load_fraction) if te is None else te,
+    )
+
+
+def _tooth_label(w: DamageWindow) -> str:
+    return f"{w.gear} tooth {w.tooth}"
+
+
+def _load_label(te: StaticTransmissionError) -> str:
+    return f"{te.load_fraction * 100:.3g} % of F_rated"
+
+
 def _stats(x: np.ndarray) -> str:
     finite = x[np.isfinite(x)]
     lost = x.size - finite.size
@@ -498,19 +513,17 @@ def summary_text(
 ) -> str:
     """Printed summary of one stage: the geometry table, k_z over the cycle, the damaged teeth and the
     static TE (computed here unless passed in)."""
-    cycle = cycle or stiffness_cycle(scenario, stage)
-    windows = damage_windows(scenario, stage) if windows is None else windows
-    te = te or static_transmission_error(scenario, stage, load_fraction)
+    cycle, windows, te = _stage_data(scenario, stage, load_fraction, cycle, windows, te)
     lines = [format_table(geometry_table(scenario, stage), stage_label(scenario, stage))]
     lines.append("  damaged teeth" if windows else "  damaged teeth: none")
     for w in windows:
         lines.append(
-            f"    {w.gear} tooth {w.tooth} ({w.description}): min k_z/k_z,healthy {w.min_ratio:.4f}, "
+            f"    {_tooth_label(w)} ({w.description}): min k_z/k_z,healthy {w.min_ratio:.4f}, "
             f"acts over u = {w.contact[0]:.3f} .. {w.contact[1]:.3f} mesh periods"
         )
     inv_mean = float(np.mean(1.0 / te.healthy_stiffness_N_per_m))
     lines.append(
-        f"  static transmission error at F = {te.force_N:.6g} N ({te.load_fraction * 100:.3g} % of F_rated "
+        f"  static transmission error at F = {te.force_N:.6g} N ({_load_label(te)} "
         f"{te.rated_force_N:.6g} N), l_u = {te.backlash_um:.4g} µm, over {te.pinion_turns} pinion turn(s)"
     )
     lines.append(
@@ -520,109 +533,3 @@ def summary_text(
     lines.append(f"    healthy:  {_stats(te.healthy_te_um)}")
     lines.append(f"    as given: {_stats(te.te_um)}")
     return "\n".join(lines)
-
-
-# -- plots -----------------------------------------------------------------------------------------
-def _shade_double(ax, cycle: StiffnessCycle) -> None:
-    h = cycle.half_double
-    if cycle.profile == "table" or h <= 0:
-        return
-    end = math.ceil(cycle.periods[-1])
-    for n in range(end + 1):
-        a, b = max(n - h, 0.0), min(n + h, float(end))
-        if b > a:
-            ax.axvspan(a, b, color="0.85", linewidth=0, zorder=0)
-
-
-def plot_stage(
-    scenario,
-    stage: int,
-    path: PathLike,
-    cycle: StiffnessCycle | None = None,
-    windows: list[DamageWindow] | None = None,
-    te: StaticTransmissionError | None = None,
-    load_fraction: float = 1.0,
-    width_px: int = 1100,
-    dpi: int = 100,
-) -> Path:
-    """One PNG of a stage: k_z over the mesh cycle (healthy), k_z around each damaged tooth (at most
-    MAX_WINDOWS_PLOTTED panels), and the static transmission error over the pinion turn(s)."""
-    from .plots import _figure, _save
-
-    cycle = cycle or stiffness_cycle(scenario, stage)
-    windows = damage_windows(scenario, stage) if windows is None else windows
-    te = te or static_transmission_error(scenario, stage, load_fraction)
-    shown = windows[:MAX_WINDOWS_PLOTTED]
-    rows = 2 + len(shown)
-    fig = _figure((width_px, 330 * rows), dpi)
-    axes = fig.subplots(rows, 1, squeeze=False)[:, 0]
-    st = scenario.stages[stage]
-    fig.suptitle(
-        f"{scenario.meta.title}\n{stage_label(scenario, stage)}: z = {st.pinion.teeth}/{st.wheel.teeth}, "
-        f"{st.mesh.stiffness_profile}",
-        fontsize=10,
-    )
-
-    ax = axes[0]
-    _shade_double(ax, cycle)
-    ax.plot(
-        cycle.periods, cycle.stiffness_N_per_m / 1e9, color="tab:blue", linewidth=1.5, label="k_z (healthy)"
-    )
-    ax.axhline(cycle.mean_N_per_m / 1e9, color="tab:green", linestyle="--", linewidth=1.0, label="mean")
-    for n in range(math.ceil(cycle.periods[-1])):
-        ax.axvline(n + cycle.pitch_point_phase, color="tab:red", linestyle=":", linewidth=1.0)
-    ax.plot([], [], color="tab:red", linestyle=":", label="pitch point")
-    if cycle.profile != "table" and cycle.half_double > 0:
-        ax.fill_between([], [], color="0.85", label="double contact")
-    ax.set_xlim(cycle.periods[0], cycle.periods[-1])
-    ax.set_ylim(bottom=0)
-    ax.set_xlabel("Mesh periods u = phi_p z1 / 2 pi [-]")
-    ax.set_ylabel("Mesh stiffness k_z [1e9 N/m]")
-    ax.set_title("k_z over the mesh cycle, healthy teeth", fontsize=10)
-    ax.legend(loc="lower right", fontsize="small")
-    ax.grid(True, alpha=0.3)
-
-    for ax, w in zip(axes[1 : 1 + len(shown)], shown, strict=True):
-        ax.axvspan(*w.contact, color="tab:red", alpha=0.08, linewidth=0, label="tooth's pair acts")
-        ax.plot(
-            w.periods,
-            w.healthy_stiffness_N_per_m / 1e9,
-            color="0.4",
-            linestyle="--",
-            linewidth=1.0,
-            label="healthy",
-        )
-        ax.plot(w.periods, w.stiffness_N_per_m / 1e9, color="tab:red", linewidth=1.5, label="as given")
-        ax.set_xlim(w.periods[0], w.periods[-1])
-        ax.set_ylim(bottom=0)
-        ax.set_xlabel("Mesh periods u = phi_p z1 / 2 pi [-]")
-        ax.set_ylabel("k_z [1e9 N/m]")
-        ax.set_title(
-            f"{w.gear} tooth {w.tooth}: {w.description} (min k_z / healthy = {w.min_ratio:.3f})", fontsize=10
-        )
-        ax.legend(loc="lower right", fontsize="small")
-        ax.grid(True, alpha=0.3)
-
-    ax = axes[-1]
-    ax.plot(te.periods, te.healthy_te_um, color="0.4", linestyle="--", linewidth=1.0, label="perfect gears")
-    ax.plot(
-        te.periods,
-        np.where(np.isfinite(te.te_um), te.te_um, np.nan),
-        color="tab:blue",
-        linewidth=0.9,
-        label="as given",
-    )
-    ax.axhline(te.backlash_um, color="tab:green", linestyle=":", linewidth=1.0, label="l_u (backlash)")
-    ax.set_xlim(0.0, te.periods[-1] + 0.5 * (te.periods[1] - te.periods[0]))
-    ax.set_xlabel("Mesh periods u = phi_p z1 / 2 pi [-] (pinion turn = z1 periods)")
-    ax.set_ylabel("Static TE [µm]")
-    ax.set_title(
-        f"Static transmission error F/k - E + l_u at F = {te.force_N:.5g} N "
-        f"({te.load_fraction * 100:.3g} % of F_rated)",
-        fontsize=10,
-    )
-    ax.legend(loc="upper right", fontsize="small")
-    ax.grid(True, alpha=0.3)
-    if len(windows) > len(shown):
-        fig.text(0.01, 0.005, f"{len(windows) - len(shown)} more damaged teeth not shown", fontsize=8)
-    return _save(fig, path, dpi)

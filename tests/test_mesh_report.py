@@ -169,8 +169,8 @@ def test_cli_refuses_bad_stage_and_load(capsys):
 
 def test_report_is_engine_free(tmp_path):
     code = (
-        "import sys; from gearbody.model import load_scenario; from gearbody import mesh_report as mr; "
-        f"s = load_scenario('one-stage'); mr.plot_stage(s, 0, {str(tmp_path / 'x.png')!r}); "
+        "import sys; from gearbody.model import load_scenario; from gearbody.mesh_plots import plot_stage; "
+        f"s = load_scenario('one-stage'); plot_stage(s, 0, {str(tmp_path / 'x.png')!r}); "
         "assert 'exudyn' not in sys.modules, 'exudyn imported'"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
