@@ -284,3 +284,22 @@ def test_static_transmission_error_is_force_over_stiffness():
     assert te[0] == pytest.approx(1e-5 - 1e-6 + 5e-5)
     assert te[1] == pytest.approx(2e-5 + 5e-5)
     assert math.isinf(te[2])
+
+
+@pytest.mark.parametrize("damage", ["crack_depth_mm=2.0", "stiffness_factor=0.5"])
+def test_steady_start_is_in_equilibrium_with_a_damaged_tooth_in_mesh(damage):
+    """The static deflection uses the law's own k (the pairs with their damage), not the healthy sum."""
+    from gearbody.engine import simulate
+
+    sc = load_scenario(
+        "one-stage-geometry",
+        [
+            'operation.initial_state="steady"',
+            "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
+            "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
+            "operation.t_end_s=0.001",
+            "solver.anti_aliasing=false",
+            f'condition.damaged_teeth=[{{gear="pinion",tooth=0,{damage}}}]',
+        ],
+    )
+    assert simulate(sc).mesh_force[0] == pytest.approx(sc.rated_mesh_force_N, rel=1e-9)

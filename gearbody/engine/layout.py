@@ -15,7 +15,7 @@ import numpy as np
 from ..model import Scenario
 from ..physics import mesh_parameters_from_scenario, pack_drive_parameters, steady_slip
 from ..physics.lateral import mesh_directions, static_bearing_displacement_m
-from ..physics.mesh import pair_in_mesh, stiffness_at_phase
+from ..physics.mesh import effective_stiffness_series, pair_in_mesh
 
 
 @dataclass(frozen=True)
@@ -219,8 +219,8 @@ def static_deflection_m(scenario: Scenario, stage: int, pinion_angle_rad: float,
     if force_N == 0.0:
         return 0.0
     P = mesh_parameters_from_scenario(scenario, stage)
-    p, factor, error_m = pair_in_mesh(pinion_angle_rad, P)
-    k = stiffness_at_phase(p, P) * factor
+    _, _, error_m = pair_in_mesh(pinion_angle_rad, P)
+    k = float(effective_stiffness_series(np.array([pinion_angle_rad]), P)[0])  # the law's k, damage included
     if k <= 0:
         raise ValueError(
             f"stage {stage + 1}: the teeth in mesh at the start carry no load (stiffness factor 0): "
