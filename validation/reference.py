@@ -13,10 +13,11 @@ segment in *locked modes*:
 
 * phase mode ``(n, k)``: the pinion mesh coordinate ``u = phi_p z1 / (2 pi)`` lies in
   ``[n + b_k, n + b_{k+1})`` where ``b`` are all phase break points in one mesh period (0, h, 1-h,
-  pitch_point_phase, error apex ``a``, table points, pit edges).  Inside such an interval every mesh
-  quantity is a polynomial (at most linear) function of ``p = u - n``, plus the smooth run-out term,
-  and is evaluated from that formula, so the right-hand side is smooth, also a little beyond the
-  interval ends during trial steps;
+  pitch_point_phase, error apex ``a``, table points, pair-table grid points, pit edges).  Inside such
+  an interval every mesh quantity is a polynomial function of ``p = u - n`` (at most linear, except
+  the "pairs" stiffness, a product of linear pieces, and the smooth steps of a transition width), plus
+  the smooth run-out term, and is evaluated from that formula, so the right-hand side is smooth, also
+  a little beyond the interval ends during trial steps;
 * contact mode ``c`` in {+1 flank contact, 0 separated, -1 back-flank contact}; only used when the
   backlash ``l_u > 0`` (with ``l_u = 0`` the spring law ``k d`` is linear and damping is on for all
   ``d != 0``, so there is nothing to switch).
@@ -47,17 +48,42 @@ jump of the law at fixed deflection is spread over ``|p - p_jump| < w/2`` with t
 ``S`` (:func:`smooth_step`): contact-ratio stiffness ramps at h and 1 - h, the tooth factor and the
 whole error blended with the outgoing pair (at phase p + 1) for p < w/2 and with the incoming pair (at
 p - 1) for p > 1 - w/2 (the triangle extended by its straight lines, :func:`error_shape_ext`), smoothed
-pit edges and a smoothed friction sign (:func:`friction_sign`); the damping uses the blended factor.
+pit edges and a smoothed friction sign (:func:`friction_sign`); the damping uses the blended factor
+("pairs": the contact weights of the outgoing and incoming pairs ramp at h and 1 - h instead of k_z, the
+factor is not blended, each pair carries its own, and the damping keeps k / k_healthy).
 The literal transcription is :func:`blended_law` / :func:`mesh_force_literal` /
 :func:`friction_moments`.  For the segmented integration the break points become the ramp ends
 ``p_jump -+ w/2`` (modulo 1), plus the kinks (p = 0 where the friction arms jump, the apex a, table
-points); inside each interval every smooth step is then 0, 1 or its quintic, and the locked mode
-carries that polynomial form (:class:`_SmoothMode`), so the right-hand side is again smooth within a
-segment.  With w = 0 nothing of this is used: the sharp code path is unchanged.
+and pair-table grid points); inside each interval every smooth step is then 0, 1 or its quintic, and
+the locked mode carries that polynomial form (:class:`_SmoothMode`, :class:`_PairMode`), so the
+right-hand side is again smooth within a segment.  With w = 0 nothing of this is used: the sharp code
+path is unchanged.
 
 The mesh force at the output times is evaluated from the (dense-output) states at those times with
 the very same function (``_mesh_force``) that the right-hand side uses, in the mode that was active
 when the sample time was reached.
+
+Stiffness profiles
+------------------
+"contact-ratio" and "table" as in the contract; "iso-6336-b" is the "contact-ratio" law (its resolved
+mesh carries stiffness_single / stiffness_double / contact_ratio) everywhere, limits included
+(:func:`mesh_law`).  "potential-energy" is the "pairs" law (docs/scenario.md, "Pair stiffness table"):
+the pair table ``design.mesh.pair_table`` (added to the resolved dict by
+``validation.compare.reference_input``; :func:`pair_table`) holds the healthy pair stiffness K_m and the
+damaged teeth's ratios R_m on the grid ``q_m = -h + m (1 + 2h)/(N - 1)``, and
+``k = sum_{o=-1,0,1} c(p - o) K f_io g_jo R_pinion,io R_wheel,jo`` (tables at the pair's own phase
+``q = p - o``, teeth ``(i + o, j + o)``), so a factor or a ratio acts on its tooth's pair over the whole
+contact; the damping is ``C_z k / k_healthy``; error, friction and their blending are unchanged.  Literal
+transcription: :func:`contact_weight`, :func:`pair_stiffness`, :func:`effective_stiffness`.  For the
+segmented integration every grid point is a break point (``p = q_m + o`` modulo 1, ~N per period), so
+each pair's tables are linear pieces in a mode (:class:`_PairMode`).  Why (measured on
+one-stage-geometry, N = 81, the short validation cases steady / separation / run-up, errors against the
+same model at rtol 1e-12): leaving the grid kinks inside the segments (tables interpolated in the
+right-hand side) takes 1.8 / 4.4 / 6.5 s but DOP853's error estimate does not see the kinks: 3.6e-3 /
+4.0e-2 / 6.7e-4 % of F_rated (RK45's does: 1e-4 / 2.4e-3 / 9e-5 % at rtol 1e-10, 9e-5 % in the separation
+case only at rtol 1e-12, 7.5 s); with the break points 1e-4 / 1.2e-5 / 4.6e-4 % in 3.8 / 17 / 5.8 s.  The
+price is one segment per grid interval: at the separation case's mesh frequency (2.8 kHz) 9x the time
+of the same gears with the "iso-6336-b" law (5 break points), 2-4x at rated speed.
 
 Gear trains
 -----------
@@ -109,6 +135,12 @@ __all__ = [
     "blended_law",
     "friction_sign",
     "base_stiffness",
+    "mesh_law",
+    "half_double",
+    "pair_table",
+    "contact_weight",
+    "pair_stiffness",
+    "effective_stiffness",
     "tooth_factors",
     "reduced_mass",
     "mesh_force_literal",
@@ -375,15 +407,15 @@ def transition_width(mesh: dict) -> float:
 
 def check_transition_width(scenario: dict) -> float:
     """The transition width w of a one-stage-shaped scenario, with the limits of the spec checked:
-    w <= min(2h, 1 - 2h) (contact-ratio), w/2 <= pitch_point_phase <= 1 - w/2 (unless 0 or 1), every
-    pit at least w wide."""
+    w <= min(2h, 1 - 2h) (every law but "table": the ramps at h and 1 - h), w/2 <= pitch_point_phase
+    <= 1 - w/2 (unless 0 or 1), every pit at least w wide."""
     mesh = scenario["design"]["mesh"]
     w = transition_width(mesh)
     if w == 0.0:
         return w
     tol = 1e-12
-    if mesh["stiffness_profile"] == "contact-ratio":
-        h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
+    if mesh_law(mesh) != "table":
+        h = half_double(mesh)
         if h > 0.0 and w > min(2.0 * h, 1.0 - 2.0 * h) + tol:
             raise ValueError(f"transition_width {w} exceeds min(2h, 1 - 2h) = {min(2 * h, 1 - 2 * h)}")
     ppp = float(mesh["pitch_point_phase"])
@@ -455,12 +487,113 @@ def friction_sign(p, pitch_point_phase: float, w: float = 0.0):
     return np.where(p < ppp, 1.0, -1.0)
 
 
-def base_stiffness(p, mesh: dict):
-    """k_z(p) without tooth factors ("contact-ratio" or "table")."""
-    p = np.asarray(p, dtype=float)
+def mesh_law(mesh: dict) -> str:
+    """The law behind design.mesh.stiffness_profile: "contact-ratio" (also "iso-6336-b": its resolved
+    mesh carries stiffness_single / stiffness_double / contact_ratio, and the law is the same), "table",
+    or "pairs" ("potential-energy": the sum of the pairs in contact, "Pair stiffness table")."""
     prof = mesh["stiffness_profile"]
-    if prof == "contact-ratio":
-        h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
+    law = {"contact-ratio": "contact-ratio", "iso-6336-b": "contact-ratio", "table": "table"}.get(prof)
+    if law is None and prof == "potential-energy":
+        law = "pairs"
+    if law is None:
+        raise ValueError(f"unknown stiffness_profile {prof!r}")
+    return law
+
+
+def half_double(mesh: dict) -> float:
+    """h = (contact_ratio - 1) / 2."""
+    return (float(mesh["contact_ratio"]) - 1.0) / 2.0
+
+
+def pair_table(mesh: dict) -> tuple[np.ndarray, np.ndarray, dict[tuple[str, int], np.ndarray]]:
+    """design.mesh.pair_table of a "pairs" mesh as (grid q_m = -h + m (1 + 2h)/(N - 1), healthy pair
+    stiffness K_m, {(gear, tooth): ratio R_m}); a tooth listed twice gets the product of its ratios."""
+    tab = mesh.get("pair_table")
+    if tab is None:
+        raise ValueError(
+            "a potential-energy mesh needs design.mesh.pair_table (see validation.compare.reference_input)"
+        )
+    K = np.asarray(tab["stiffness_N_per_m"], dtype=float).ravel()
+    N = K.size
+    if N < 2:
+        raise ValueError("the pair stiffness table needs at least 2 points")
+    h = half_double(mesh)
+    grid = -h + np.arange(N) * ((1.0 + 2.0 * h) / (N - 1))
+    ratios: dict[tuple[str, int], np.ndarray] = {}
+    for entry in tab.get("ratios", []):
+        gear, tooth = entry["gear"], int(entry["tooth"])
+        if gear not in ("pinion", "wheel"):
+            raise ValueError(f"pair_table ratio for unknown gear {gear!r}")
+        R = np.asarray(entry["ratio"], dtype=float).ravel()
+        if R.size != N:
+            raise ValueError(f"ratio table of {gear} tooth {tooth} has {R.size} points, the pair table {N}")
+        ratios[(gear, tooth)] = ratios[(gear, tooth)] * R if (gear, tooth) in ratios else R
+    return grid, K, ratios
+
+
+def contact_weight(q, h: float, w: float = 0.0):
+    """Contact weight of a pair at its own phase q: 1 for -h <= q < 1 + h, else 0;
+    with a transition width w > 0: S((q + h)/w) [1 - S((q - 1 - h)/w)]."""
+    q = np.asarray(q, dtype=float)
+    if w > 0.0:
+        return smooth_step((q + h) / w) * (1.0 - smooth_step((q - 1.0 - h) / w))
+    return np.where((-h <= q) & (q < 1.0 + h), 1.0, 0.0)
+
+
+def pair_stiffness(scenario: dict, u, healthy: bool = False):
+    """The "pairs" law at the mesh coordinate u (literal): with p, n from u and the period's teeth
+    (i, j) = (n mod z1, n mod z2), k = sum over o = -1, 0, +1 of c(q) K(q) f_io g_jo R_pinion,io(q)
+    R_wheel,jo(q), q = p - o, (io, jo) = (i + o, j + o) (modulo z1, z2); K and R linear between the
+    grid points and held at their end values outside.  healthy: all f, g, R = 1 (:func:`base_stiffness`)."""
+    mesh = scenario["design"]["mesh"]
+    u = np.asarray(u, dtype=float)
+    n = np.floor(u).astype(np.int64)
+    p = u - n
+    if healthy:
+        return base_stiffness(p, mesh)
+    z1 = int(scenario["design"]["pinion"]["teeth"])
+    z2 = int(scenario["design"]["wheel"]["teeth"])
+    grid, K, ratios = pair_table(mesh)
+    h, w = half_double(mesh), transition_width(mesh)
+    f, g = tooth_factors(scenario)
+    k = np.zeros(u.shape)
+    for o in (-1, 0, 1):
+        q = p - o
+        io, jo = np.mod(n + o, z1), np.mod(n + o, z2)
+        term = contact_weight(q, h, w) * np.interp(q, grid, K) * f[io] * g[jo]
+        for (gear, tooth), R in ratios.items():
+            on = (io if gear == "pinion" else jo) == tooth
+            term = term * np.where(on, np.interp(q, grid, R), 1.0)
+        k = k + term
+    return k
+
+
+def effective_stiffness(scenario: dict, u) -> tuple[np.ndarray, np.ndarray]:
+    """Stiffness k of the law at the mesh coordinate u and the factor of its damping: k_z(p) f_i g_j and
+    f_i g_j (w > 0: the blended factor); "pairs": the pair sum and k / k_healthy."""
+    mesh = scenario["design"]["mesh"]
+    u = np.asarray(u, dtype=float)
+    if mesh_law(mesh) == "pairs":
+        k = pair_stiffness(scenario, u)
+        return k, k / pair_stiffness(scenario, u, healthy=True)
+    n = np.floor(u).astype(np.int64)
+    p = u - n
+    if transition_width(mesh) > 0.0:  # factor blended with the outgoing / incoming pair
+        fg = blended_law(scenario, u)[0]
+    else:
+        f, g = tooth_factors(scenario)
+        fg = f[np.mod(n, int(scenario["design"]["pinion"]["teeth"]))]
+        fg = fg * g[np.mod(n, int(scenario["design"]["wheel"]["teeth"]))]
+    return base_stiffness(p, mesh) * fg, fg
+
+
+def base_stiffness(p, mesh: dict):
+    """k_z(p) of healthy teeth: "contact-ratio" (and "iso-6336-b"), "table", or the "pairs" sum
+    sum_o c(p - o) K(p - o) over o = -1, 0, +1."""
+    p = np.asarray(p, dtype=float)
+    law = mesh_law(mesh)
+    if law == "contact-ratio":
+        h = half_double(mesh)
         k_double = float(mesh["stiffness_double_N_per_m"])
         w = transition_width(mesh)
         if w > 0.0:  # k_s + (k_d - k_s) [1 - S((p - h)/w) + S((p - 1 + h)/w)]
@@ -469,13 +602,15 @@ def base_stiffness(p, mesh: dict):
             return k_single + (k_double - k_single) * ramp
         double = (p < h) | (p >= 1.0 - h)
         return np.where(double, k_double, float(mesh["stiffness_single_N_per_m"]))
-    if prof == "table":
-        ph = np.asarray(mesh["table_phase"], dtype=float)
-        kk = np.asarray(mesh["table_stiffness_N_per_m"], dtype=float)
-        if ph.size == 0 or ph.size != kk.size:
-            raise ValueError("table stiffness profile needs equally long, non-empty tables")
-        return np.interp(p, ph, kk, period=1.0)
-    raise ValueError(f"unknown stiffness_profile {prof!r}")
+    if law == "pairs":
+        grid, K, _ = pair_table(mesh)
+        h, w = half_double(mesh), transition_width(mesh)
+        return sum(contact_weight(p - o, h, w) * np.interp(p - o, grid, K) for o in (-1, 0, 1))
+    ph = np.asarray(mesh["table_phase"], dtype=float)
+    kk = np.asarray(mesh["table_stiffness_N_per_m"], dtype=float)
+    if ph.size == 0 or ph.size != kk.size:
+        raise ValueError("table stiffness profile needs equally long, non-empty tables")
+    return np.interp(p, ph, kk, period=1.0)
 
 
 def tooth_factors(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -492,7 +627,7 @@ def tooth_factors(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
         tooth = int(entry["tooth"])
         if not 0 <= tooth < arr.size:
             raise ValueError(f"damaged tooth index {tooth} out of range for the {entry['gear']}")
-        arr[tooth] *= float(entry["stiffness_factor"])
+        arr[tooth] *= float(entry.get("stiffness_factor", 1.0))  # default 1 (crack keys alone)
     return f, g
 
 
@@ -518,18 +653,16 @@ def mesh_force_literal(scenario: dict, u, delta, delta_dot) -> dict:
     p = u - n
     i = np.mod(n, z1)
     j = np.mod(n, z2)
-    if transition_width(mesh) > 0.0:  # blended tooth factor and error near the tooth change
-        fg, E = blended_law(scenario, u)
-        k = base_stiffness(p, mesh) * fg
-        Cf = float(mesh["damping_Ns_per_m"]) * fg  # the damping uses the blended factor
+    # k = k_z(p) f_i g_j and the damping factor f_i g_j (w > 0: blended at the tooth change);
+    # "pairs": the sum over the pairs in contact and k / k_healthy
+    k, fg = effective_stiffness(scenario, u)
+    Cf = float(mesh["damping_Ns_per_m"]) * fg
+    if transition_width(mesh) > 0.0:  # error blended near the tooth change
+        E = blended_law(scenario, u)[1]
     else:
-        f, g = tooth_factors(scenario)
-        fg = f[i] * g[j]
-        k = base_stiffness(p, mesh) * f[i] * g[j]
         e_i = tooth_error_amplitudes(scenario)[i]
         E = error_shape(p, float(scenario["production"]["error_mode"]["a"]), e_i)
         E = E + runout_error(scenario, u) + pit_error(scenario, p, i, j)  # fault errors: in d only
-        Cf = float(mesh["damping_Ns_per_m"]) * f[i] * g[j]
     d = np.asarray(delta, dtype=float) + E
     lu = float(mesh["backlash_um"]) * 1e-6
     F_el = k * np.maximum(d - lu, np.minimum(d + lu, 0.0))
@@ -587,11 +720,7 @@ def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     M_L = float(d_["machine"]["rated_torque_Nm"]) * load0
     F0 = M_L / r2
     M_p = F0 * r1
-    f, g = tooth_factors(scenario)
-    if transition_width(mesh) > 0.0:  # the law at u = 0: factor blended with the outgoing pair
-        k0 = float(base_stiffness(0.0, mesh)) * float(blended_law(scenario, 0.0)[0])
-    else:
-        k0 = float(base_stiffness(0.0, mesh)) * f[0] * g[0]
+    k0 = float(effective_stiffness(scenario, 0.0)[0])  # w > 0: factor blended with the outgoing pair
     E0 = float(total_error(scenario, 0.0))  # total error at p = 0, tooth 0 (fault errors included)
     delta0 = F0 / k0 + lu - E0 if F0 != 0.0 else 0.0
     if scene == "muller":
@@ -631,7 +760,6 @@ def _train_initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     r_p = [float(st["pinion"]["base_radius_m"]) for st in stages]
     r_w = [float(st["wheel"]["base_radius_m"]) for st in stages]
     z_p = [int(st["pinion"]["teeth"]) for st in stages]
-    z_w = [int(st["wheel"]["teeth"]) for st in stages]
     F = [load0 * Fr for Fr in stage_F_rated(scenario)]  # F_s = f F_rated,s
     pinion_torque = [F[s] * r_p[s] for s in range(N)]
     # speeds: motor = pinion 1 from the Kloss stable branch, wheel = pinion r_p / r_w, next pinion = wheel
@@ -651,14 +779,7 @@ def _train_initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
         view = stage_view(scenario, s)
         mesh = view["design"]["mesh"]
         u = pinion * z_p[s] / TWO_PI
-        n = math.floor(u)
-        p = u - n
-        i, j = n % z_p[s], n % z_w[s]
-        f, g = tooth_factors(view)
-        if transition_width(mesh) > 0.0:  # the law at u: factor blended near the tooth change
-            k = float(base_stiffness(p, mesh)) * float(blended_law(view, u)[0])
-        else:
-            k = float(base_stiffness(p, mesh)) * f[i] * g[j]
+        k = float(effective_stiffness(view, u)[0])  # w > 0: factor blended near the tooth change
         E = float(total_error(view, u))  # fault errors included
         lu = float(mesh["backlash_um"]) * 1e-6
         if F[s] == 0.0:
@@ -684,11 +805,14 @@ def phase_breakpoints(scenario: dict) -> np.ndarray:
     if w > 0.0:
         return _phase_breakpoints_smooth(scenario, w)
     pts = [0.0]
-    if mesh["stiffness_profile"] == "contact-ratio":
-        h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
-        pts += [h, 1.0 - h]
-    else:
+    law = mesh_law(mesh)
+    if law == "table":
         pts += [float(x) % 1.0 for x in mesh["table_phase"]]
+    else:  # contact-ratio: k_z jumps; pairs: a pair leaves at h and one enters at 1 - h
+        h = half_double(mesh)
+        pts += [h, 1.0 - h]
+    if law == "pairs":  # kinks of the pair tables: the grid points q_m, at p = q_m + o (mod 1)
+        pts += [float(x) % 1.0 for x in pair_table(mesh)[0]]
     pts.append(float(scenario["production"]["error_mode"]["a"]))
     if scenario["meta"]["scene"] != "muller" and float(scenario["condition"]["friction_coefficient"]) != 0.0:
         pts.append(float(mesh["pitch_point_phase"]))
@@ -715,11 +839,14 @@ def _phase_breakpoints_smooth(scenario: dict, w: float) -> np.ndarray:
     mesh = scenario["design"]["mesh"]
     centres = [0.0]  # tooth change
     kinks = [0.0, float(scenario["production"]["error_mode"]["a"]) % 1.0]
-    if mesh["stiffness_profile"] == "contact-ratio":
-        h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
-        centres += [h, 1.0 - h]
-    else:
+    law = mesh_law(mesh)
+    if law == "table":
         kinks += [float(x) % 1.0 for x in mesh["table_phase"]]
+    else:  # contact-ratio ramps; pairs: contact weights of the outgoing / incoming pair
+        h = half_double(mesh)
+        centres += [h, 1.0 - h]
+    if law == "pairs":
+        kinks += [float(x) % 1.0 for x in pair_table(mesh)[0]]
     ppp = float(mesh["pitch_point_phase"])
     if scenario["meta"]["scene"] != "muller" and float(scenario["condition"]["friction_coefficient"]) != 0.0:
         if 0.0 < ppp < 1.0:
@@ -755,6 +882,7 @@ class _ModeConsts(NamedTuple):
     nf: float  # n, so that u = n + p
     runout: tuple  # (A, 2 pi / z, theta) per run-out term: A sin(2 pi u / z + theta)
     tw: _SmoothMode | None = None  # transition width w > 0: the smoothed law of this mode (else None)
+    pk: _PairMode | None = None  # "pairs" law: the pairs in contact in this mode (else None)
 
 
 def _mode_error(mc: _ModeConsts, p):
@@ -779,6 +907,9 @@ def _mesh_force(mc: _ModeConsts, p, delta, delta_dot):
     if mc.c == 0:
         return 0.0 * (p + delta + delta_dot)
     d = delta + _mode_error(mc, p)
+    if mc.pk is not None:  # "pairs": k from the pairs in contact, damping C_z k / k_healthy
+        k, k_healthy = _pairs_eval(mc.pk, p)
+        return k * (d - mc.c * mc.lu) + mc.Cf * (k / k_healthy) * delta_dot
     tw = mc.tw
     if tw is not None:  # blended factor (also in the damping) and smoothed stiffness
         fg = _smooth_factor(tw, p)
@@ -852,6 +983,35 @@ class _PolyBuilder:
         return (self.A, self.B, tuple(self.terms))
 
 
+# ----------------------------------------------------------------------------------------------
+# Locked-mode form of the "pairs" law
+# ----------------------------------------------------------------------------------------------
+# In phase interval k of mesh period n the pairs o = -1, 0, +1 whose contact weight is not 0 there are
+# listed with their teeth's factor f g and the tables to multiply (K, then the ratio table of a damaged
+# pinion / wheel tooth of that pair), each as its linear piece on the interval, (v0, slope, p0):
+# v0 + slope (p - p0) (all grid points q_m are break points at p = q_m + o mod 1, so a pair's own phase
+# q = p - o stays between two grid points).  The contact weight is 1 (w = 0: h and 1 - h are break
+# points) or a locked smooth step (w > 0).  So k is a polynomial in p on the interval (evaluated also a
+# little beyond its ends during trial steps), and the damping factor k / k_healthy a smooth quotient.
+class _PairMode(NamedTuple):
+    terms: tuple  # per pair in contact: (weight poly | None, f g, ((v0, slope, p0) per table))
+
+
+def _pairs_eval(pm: _PairMode, p):
+    """k = sum over the pairs of c f g K R_p R_w and k_healthy = sum c K at p (float or array)."""
+    k = k_healthy = 0.0
+    for weight, fg, tables in pm.terms:
+        v0, slope, p0 = tables[0]
+        kq = v0 + slope * (p - p0)
+        if weight is not None:
+            kq = kq * _poly_eval(weight, p)
+        k_healthy = k_healthy + kq
+        for v0, slope, p0 in tables[1:]:
+            kq = kq * (v0 + slope * (p - p0))
+        k = k + fg * kq
+    return k, k_healthy
+
+
 class _Mesh:
     """Constants of one gear mesh, plus its per-mode constants.
 
@@ -882,6 +1042,17 @@ class _Mesh:
         self.Frated = F_rated(sc) if Frated is None else float(Frated)
         self.w = check_transition_width(sc)
         self.mesh = mesh
+        self.law = mesh_law(mesh)
+        if self.law == "pairs":
+            grid, K, ratios = pair_table(mesh)
+            for gear, tooth in ratios:
+                if not 0 <= tooth < (self.z1 if gear == "pinion" else self.z2):
+                    raise ValueError(f"pair_table ratio for {gear} tooth {tooth}, which does not exist")
+            self.h = half_double(mesh)
+            self.grid = grid
+            self.Ktab = K.tolist()
+            self.ratios = {key: R.tolist() for key, R in ratios.items()}
+            self.inv_dq = (K.size - 1) / (1.0 + 2.0 * self.h)
         # phase intervals
         b = phase_breakpoints(sc)
         self.bA = b
@@ -891,7 +1062,7 @@ class _Mesh:
         for k in range(self.K):
             lo, hi = float(self.bA[k]), float(self.bB[k])
             mid = 0.5 * (lo + hi)
-            if mesh["stiffness_profile"] == "contact-ratio":
+            if self.law != "table":  # pairs: not used (the mode's _PairMode)
                 kA, kS = float(base_stiffness(mid, mesh)), 0.0
             else:
                 kA = float(base_stiffness(lo, mesh))
@@ -916,13 +1087,13 @@ class _Mesh:
         mid = 0.5 * (lo + hi)
         mesh = self.mesh
         # stiffness k_z = k_s + (k_d - k_s) [1 - S((p - h)/w) + S((p - 1 + h)/w)]; tables unchanged
-        if mesh["stiffness_profile"] == "contact-ratio":
-            h = (float(mesh["contact_ratio"]) - 1.0) / 2.0
+        if self.law == "contact-ratio":
+            h = half_double(mesh)
             ks, kd = float(mesh["stiffness_single_N_per_m"]), float(mesh["stiffness_double_N_per_m"])
             kz = _PolyBuilder(w, mid, A=kd)
             kz.step(-(kd - ks), h)
             kz.step(kd - ks, 1.0 - h)
-        else:
+        else:  # table (pairs: not used)
             kA, kS = self.iv[k][0], self.iv[k][1]
             kz = _PolyBuilder(w, mid, A=kA - kS * lo, B=kS)
         # friction: mu s, s = 2 [S(p/w) - S((p - pitch)/w) + S((p - 1)/w)] - 1 (0 < pitch < 1)
@@ -971,10 +1142,56 @@ class _Mesh:
             Cz=self.Cz,
         )
 
+    def pair_mode(self, n: int, k: int) -> _PairMode:
+        """The "pairs" law on phase interval k of mesh period n, in locked form (see _PairMode)."""
+        lo, hi = float(self.bA[k]), float(self.bB[k])
+        mid = 0.5 * (lo + hi)
+        h, w = self.h, self.w
+        terms = []
+        for o in (-1, 0, 1):
+            shift = -float(o)  # own phase q = p - o
+            qmid = mid + shift
+            weight = None
+            if w > 0.0:  # c = S((q + h)/w) [1 - S((q - 1 - h)/w)], as a function of p
+                enter = _PolyBuilder(w, mid)
+                enter.step(1.0, o - h)
+                leave = _PolyBuilder(w, mid, A=1.0)
+                leave.step(-1.0, o + 1.0 + h)
+                parts = [b.done() for b in (enter, leave)]
+                if any(A == 0.0 and not terms_ for A, _B, terms_ in parts):
+                    continue  # out of contact on the whole interval
+                ramps = [P for P in parts if P[2]]
+                if len(ramps) > 1:
+                    raise ValueError("transition width too wide for the contact ratio")
+                weight = ramps[0] if ramps else None
+            elif not -h <= qmid < 1.0 + h:
+                continue
+            io, jo = (n + o) % self.z1, (n + o) % self.z2
+            tables = [self.Ktab]
+            for key in (("pinion", io), ("wheel", jo)):
+                if key in self.ratios:
+                    tables.append(self.ratios[key])
+            pieces = tuple(self._linear_piece(T, qmid, shift) for T in tables)
+            terms.append((weight, float(self.f[io] * self.g[jo]), pieces))
+        return _PairMode(tuple(terms))
+
+    def _linear_piece(self, T: list, qmid: float, shift: float) -> tuple[float, float, float]:
+        """The piece of table T through own phase qmid as (v0, slope, p0): v0 + slope (p - p0)."""
+        x = (qmid + self.h) * self.inv_dq
+        if x <= 0.0:
+            return T[0], 0.0, 0.0
+        m = int(x)
+        if m >= len(T) - 1:
+            return T[-1], 0.0, 0.0
+        return T[m], (T[m + 1] - T[m]) * self.inv_dq, float(self.grid[m]) - shift
+
     def mode_consts(self, n: int, k: int, c: int) -> _ModeConsts:
         kA, kS, Ea, Eb, _s = self.iv[k]
         i, j = n % self.z1, n % self.z2
         fg = self.f[i] * self.g[j]
+        pk = None
+        if self.law == "pairs":  # the damping factor k / k_healthy is formed by _mesh_force
+            pk, fg = self.pair_mode(n, k), 1.0
         mid = 0.5 * (float(self.bA[k]) + float(self.bB[k]))
         pit = 0.0
         for gear, tooth, depth, lo, hi in self.pits:
@@ -995,6 +1212,7 @@ class _Mesh:
             nf=float(n),
             runout=self.runout,
             tw=self.smooth_mode(n, k) if self.w > 0.0 else None,
+            pk=pk,
         )
 
     def phase_mode(self, u: float, u_dot: float) -> tuple[int, int]:

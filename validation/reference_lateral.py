@@ -3,8 +3,12 @@ models: gears on bearings (Figs. 17, 18)"): gears of a ``one-stage`` scene or of
 centres translate in the housing's x-y plane on a ``linear`` or ``hertzian`` bearing.
 
 Written from the contract only; it shares no code with ``gearbody``.  It reuses the torsional helpers of
-:mod:`validation.reference` (random draw, error shape, stiffness profile, tooth factors, Kloss, profiles,
-the locked-mode mesh law and the segment integrator with its missed-event scan).
+:mod:`validation.reference` (random draw, error shape, stiffness profiles, tooth factors, Kloss, profiles,
+the locked-mode mesh law and the segment integrator with its missed-event scan).  So every stiffness
+profile of the torsional reference works here too: "iso-6336-b" as "contact-ratio", and the "pairs" law
+of "potential-energy" (pair table ``mesh.pair_table`` from ``validation.compare.reference_input``, its
+grid points as phase break points, damping ``C_z k / k_healthy``); the steady start uses the law's
+effective stiffness at the initial phase (:func:`validation.reference.effective_stiffness`).
 
 Model
 -----
@@ -608,7 +612,6 @@ def initial_state_lateral(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     r_p = [float(st["pinion"]["base_radius_m"]) for st in stages]
     r_w = [float(st["wheel"]["base_radius_m"]) for st in stages]
     z_p = [int(st["pinion"]["teeth"]) for st in stages]
-    z_w = [int(st["wheel"]["teeth"]) for st in stages]
     F = [load0 * Fr for Fr in model.Frated]
     pinion_torque = [F[s] * r_p[s] for s in range(N)]
     motor = d_["motor"]
@@ -626,14 +629,7 @@ def initial_state_lateral(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
         view = ref.stage_view(sc, s)
         mesh = view["design"]["mesh"]
         u = pinion * z_p[s] / TWO_PI
-        n = math.floor(u)
-        p = u - n
-        i, j = n % z_p[s], n % z_w[s]
-        f, g = ref.tooth_factors(view)
-        if ref.transition_width(mesh) > 0.0:  # the law at u: factor blended near the tooth change
-            k = float(ref.base_stiffness(p, mesh)) * float(ref.blended_law(view, u)[0])
-        else:
-            k = float(ref.base_stiffness(p, mesh)) * f[i] * g[j]
+        k = float(ref.effective_stiffness(view, u)[0])  # w > 0: blended factor; pairs: the pair sum
         E = float(ref.total_error(view, u))  # fault errors included
         lu = float(mesh["backlash_um"]) * 1e-6
         if F[s] == 0.0:
