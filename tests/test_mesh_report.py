@@ -173,5 +173,5 @@ def test_report_is_engine_free(tmp_path):
         f"s = load_scenario('one-stage'); plot_stage(s, 0, {str(tmp_path / 'x.png')!r}); "
         "assert 'exudyn' not in sys.modules, 'exudyn imported'"
     )
-    subprocess.run([sys.executable, "-c", code], check=True)
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=tmp_path)  # installed gearbody
     assert (tmp_path / "x.png").is_file()
