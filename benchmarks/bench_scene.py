@@ -35,10 +35,10 @@ RATED = [
 def _reference(scenario):
     """The independent reference for the scene: torsional, or with gears on bearings."""
     if scenario.is_lateral:
-        from gearbody.validation.reference_lateral import simulate_reference_lateral
+        from gearbody_validation.reference_lateral import simulate_reference_lateral
 
         return simulate_reference_lateral
-    from gearbody.validation.reference import simulate_reference
+    from gearbody_validation.reference import simulate_reference
 
     return simulate_reference
 

@@ -73,9 +73,9 @@ def _job(kind: str, scene: str, t_end: float, extra: list[str], arg: float | Non
         out = (wall, st["steps"], st["rejected_steps"], r.time_s, r.mesh_force)
     elif kind == "reference":
         if sc.is_lateral:
-            from gearbody.validation.reference_lateral import simulate_reference_lateral as ref
+            from gearbody_validation.reference_lateral import simulate_reference_lateral as ref
         else:
-            from gearbody.validation.reference import simulate_reference as ref
+            from gearbody_validation.reference import simulate_reference as ref
         t = np.arange(round(t_end * sc.solver.output_rate_hz) + 1) / sc.solver.output_rate_hz
         t0 = time.perf_counter()
         r = ref(scenario_to_dict(sc), t_eval=t)

@@ -612,7 +612,7 @@ def _parse_sweep(text: str) -> tuple:
 
 
 def main() -> None:
-    from gearbody.validation.reference import simulate_reference
+    from gearbody_validation.reference import simulate_reference
 
     from gearbody.model import load_scenario, scenario_to_dict
 

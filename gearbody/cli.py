@@ -262,7 +262,7 @@ def _load(scene: str, overrides: list[str]):
 
 def cmd_list(_args) -> int:
     from .model import load_scenario
-    from .scenes import list_scenes
+    from .model.scenes import list_scenes
 
     for name in list_scenes():
         print(f"{name}\t{load_scenario(name).meta.title}")
@@ -367,7 +367,7 @@ def cmd_mesh(args) -> int:
 
 
 def cmd_validate(args) -> int:
-    from .validation.compare import run_validation
+    from gearbody_validation.compare import run_validation
 
     ok = run_validation(args.scenes or None, short=args.short, tolerance_percent=args.tolerance)
     return 0 if ok else 1

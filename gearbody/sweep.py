@@ -289,7 +289,7 @@ class Case:
 
 def _resolve_scene(scene: str | Path) -> tuple[str, Path]:
     """(label stored in the spec, TOML path), as :func:`gearbody.model.load_scenario` resolves it."""
-    from .scenes import scene_path
+    from .model.scenes import scene_path
 
     path = Path(scene)
     if not path.suffix and not path.exists():

@@ -5,6 +5,7 @@ import pytest
 
 import gearbody as gb
 from gearbody.engine import SimulationError, simulate
+from gearbody.errors import InputError
 from gearbody.model import load_scenario
 
 STEADY = [
@@ -91,12 +92,12 @@ def test_muller_pitch_line_is_kinematic():
 
 
 def test_motor_that_cannot_carry_the_load_is_reported_before_running():
-    with pytest.raises(SimulationError, match="breakdown torque"):
+    with pytest.raises(InputError, match="breakdown torque"):  # an input error (exit 2), not numerical
         simulate(steady("one-stage", "design.machine.rated_torque_Nm=6000"))
 
 
 def test_steady_start_on_a_broken_tooth_is_refused_with_a_hint():
-    with pytest.raises(SimulationError, match="carry no load"):
+    with pytest.raises(InputError, match="carry no load"):
         broken = 'condition.damaged_teeth=[{gear="pinion",tooth=0,stiffness_factor=0.0}]'
         simulate(steady("one-stage", broken))
 

@@ -241,7 +241,7 @@ def test_lateral_gear_needs_a_bearing_and_a_lateral_scene():
 
 def test_a_train_with_lateral_gears_agrees_with_the_independent_reference():
     """Deliverable 3: lateral DOFs per gear in any stage of a train, from the description alone."""
-    from gearbody.validation.reference_lateral import simulate_reference_lateral
+    from gearbody_validation.reference_lateral import simulate_reference_lateral
 
     data = scenario_to_dict(
         load_scenario("two-stage", [*STEADY, "operation.t_end_s=0.03", "solver.anti_aliasing=false"])

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from gearbody.scenes import scene_path
+from gearbody.model.scenes import scene_path
 
 from gearbody.model import ScenarioError, load_scenario, scenario_to_dict
 from gearbody.model.io import read_toml

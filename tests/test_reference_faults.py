@@ -13,8 +13,8 @@ import pathlib
 
 import numpy as np
 import pytest
-from gearbody.validation import reference as ref
-from gearbody.validation import reference_lateral as lat
+from gearbody_validation import reference as ref
+from gearbody_validation import reference_lateral as lat
 from scipy.integrate import solve_ivp
 
 from gearbody.model import load_scenario, scenario_to_dict

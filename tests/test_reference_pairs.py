@@ -17,7 +17,7 @@ import pathlib
 
 import numpy as np
 import pytest
-from gearbody.validation import reference as ref
+from gearbody_validation import reference as ref
 
 SCEN = pathlib.Path(__file__).resolve().parents[1] / "validation" / "scenarios"
 
@@ -332,7 +332,7 @@ def _max_error(res, out, sc) -> float:
 
 @pytest.mark.parametrize("case", list(ONE_STAGE))
 def test_one_stage_geometry_agrees_with_gearbody(case):
-    from gearbody.validation.compare import reference_input
+    from gearbody_validation.compare import reference_input
 
     from gearbody.engine import simulate
     from gearbody.model import load_scenario
@@ -346,7 +346,7 @@ def test_one_stage_geometry_agrees_with_gearbody(case):
 
 
 def test_train_stage_agrees_with_gearbody():
-    from gearbody.validation.compare import reference_input
+    from gearbody_validation.compare import reference_input
 
     from gearbody.engine import simulate
     from gearbody.model import load_scenario, scenario_to_dict
@@ -363,8 +363,8 @@ def test_train_stage_agrees_with_gearbody():
 
 def test_lateral_agrees_with_gearbody():
     """lateral-8dof with its mesh stated by geometry (as one-stage-geometry) and a cracked wheel tooth."""
-    from gearbody.validation.compare import reference_input
-    from gearbody.validation.reference_lateral import simulate_reference_lateral
+    from gearbody_validation.compare import reference_input
+    from gearbody_validation.reference_lateral import simulate_reference_lateral
 
     from gearbody.engine import simulate
     from gearbody.model import load_scenario, scenario_to_dict

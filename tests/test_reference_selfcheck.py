@@ -11,7 +11,7 @@ import pathlib
 
 import numpy as np
 import pytest
-from gearbody.validation import reference as ref
+from gearbody_validation import reference as ref
 from scipy.integrate import solve_ivp
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]

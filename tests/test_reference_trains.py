@@ -1,6 +1,6 @@
 """Self-checks of the independent reference model for gear trains (scene "train", docs/scenario.md).
 
-Like tests/test_reference_selfcheck.py these never import gearbody code: `gearbody.validation` is the
+Like tests/test_reference_selfcheck.py these never import gearbody code: `gearbody_validation` is the
 installed name of the validation/ folder.
 """
 
@@ -12,7 +12,7 @@ import pathlib
 
 import numpy as np
 import pytest
-from gearbody.validation import reference as ref
+from gearbody_validation import reference as ref
 from scipy.integrate import solve_ivp
 
 SCEN = pathlib.Path(__file__).resolve().parents[1] / "validation" / "scenarios"

@@ -14,7 +14,7 @@ import pathlib
 
 import numpy as np
 import pytest
-from gearbody.validation import reference as ref
+from gearbody_validation import reference as ref
 
 SCEN = pathlib.Path(__file__).resolve().parents[1] / "validation" / "scenarios"
 W = 0.05  # transition width used by the hand-computed cases
@@ -323,7 +323,7 @@ def test_two_stage_train_with_per_stage_widths_agrees_with_gearbody():
 
 
 def test_lateral_8dof_agrees_with_gearbody():
-    from gearbody.validation.reference_lateral import simulate_reference_lateral
+    from gearbody_validation.reference_lateral import simulate_reference_lateral
 
     from gearbody.engine import simulate
     from gearbody.model import load_scenario, scenario_to_dict

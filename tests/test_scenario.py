@@ -3,7 +3,7 @@
 import re
 
 import pytest
-from gearbody.scenes import list_scenes, scene_path
+from gearbody.model.scenes import list_scenes, scene_path
 
 from gearbody.model import ScenarioError, dump_scenario, load_scenario, parse_override, scenario_to_dict
 

@@ -7,7 +7,8 @@ import pytest
 import scipy.linalg
 
 from gearbody.engine import scene_modes, simulate
-from gearbody.model import ScenarioError, load_scenario, scenario_to_dict
+from gearbody.model import ScenarioError, load_scenario, scenario_to_dict, scene_path
+from gearbody.model.io import read_toml
 
 STEADY = [
     'operation.initial_state="steady"',
@@ -17,20 +18,22 @@ STEADY = [
 
 
 def one_stage_as_train(*overrides):
+    """The one-stage scene as loaded from its shorthand file, and the same drive written by hand as
+    [[design.stages]] and [[design.shafts]] (not by gearbody's own conversion)."""
     sc = load_scenario("one-stage", list(overrides))
-    d = scenario_to_dict(sc)
+    d = read_toml(scene_path("one-stage"))
     design = d["design"]
     stage = {
         "pinion": design.pop("pinion"),
         "wheel": design.pop("wheel"),
         "mesh": design.pop("mesh"),
-        "error_mode": d["production"]["error_mode"],
-        "damaged_teeth": d["condition"]["damaged_teeth"],
+        "error_mode": d.pop("production")["error_mode"],
     }
     design["shafts"] = [design.pop("coupling"), design.pop("output_shaft")]
     design["stages"] = [stage]
-    d["meta"]["scene"] = "train"
-    return sc, load_scenario(d)
+    d["meta"]["name"] = "one-stage"
+    stage_overrides = [o.replace("condition.damaged_teeth", "design.stages.1.damaged_teeth") for o in overrides]
+    return sc, load_scenario(d, stage_overrides)
 
 
 def test_a_one_stage_train_is_the_one_stage_scene():
@@ -98,7 +101,10 @@ def test_two_stage_modes_equal_eigh_on_hand_built_matrices():
     ("override", "message"),
     [
         ("design.shafts=[]", "needs 3"),
-        ("design.pinion={teeth=20,base_radius_m=0.05,inertia_kg_m2=0.1,mass_kg=1.0}", "remove design.pinion"),
+        (
+            "design.pinion={teeth=20,base_radius_m=0.05,inertia_kg_m2=0.1,mass_kg=1.0}",
+            "design.pinion does not apply to a drive of 2 stages; write design.stages.N.pinion with N = 1..2",
+        ),
         ("design.stages=[]", "at least one"),
     ],
 )
@@ -107,6 +113,8 @@ def test_train_descriptions_are_checked(override, message):
         load_scenario("two-stage", [override])
 
 
-def test_stage_keys_are_refused_outside_trains():
-    with pytest.raises(ScenarioError, match="belong to scene 'train'"):
-        load_scenario("one-stage", ["design.shafts=[{stiffness_Nm_per_rad=1e5}]"])
+def test_shaft_keys_are_refused_outside_trains():
+    with pytest.raises(ScenarioError, match="topology 'two-wheel' has no shafts"):
+        load_scenario("two-wheel", ["design.shafts=[{stiffness_Nm_per_rad=1e5}]"])
+    with pytest.raises(ScenarioError, match="design.coupling does not apply to topology 'two-wheel'"):
+        load_scenario("two-wheel", ["design.coupling.stiffness_Nm_per_rad=1e5"])

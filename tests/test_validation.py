@@ -2,8 +2,8 @@
 
 import numpy as np
 import pytest
-from gearbody.validation.compare import VALIDATED_SCENES, cases, compare_case, run_validation
-from gearbody.validation.reference import simulate_reference
+from gearbody_validation.compare import VALIDATED_SCENES, cases, compare_case, run_validation
+from gearbody_validation.reference import simulate_reference
 
 from gearbody.engine import simulate
 from gearbody.model import load_scenario, scenario_to_dict
@@ -32,8 +32,8 @@ def test_comparison_detects_a_model_difference():
 
 def test_bearing_comparison_detects_a_model_difference():
     """A reference whose wheel bearing is 10 % stiffer in y differs by more than the 1 % bearing limit."""
-    from gearbody.validation.compare import bearing_force_errors_percent
-    from gearbody.validation.reference_lateral import simulate_reference_lateral
+    from gearbody_validation.compare import bearing_force_errors_percent
+    from gearbody_validation.reference_lateral import simulate_reference_lateral
 
     overrides = [*cases("lateral-8dof")[0].overrides, "operation.t_end_s=0.03", "solver.anti_aliasing=false"]
     sc = load_scenario("lateral-8dof", overrides)

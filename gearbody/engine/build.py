@@ -39,14 +39,8 @@ from ..model import Scenario
 from ..physics import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
 from ..physics.lateral import lateral_mesh_forces, tangent_stiffness_N_per_m
-from ..physics.mesh import (
-    mesh_contact,
-    mesh_parameters_from_scenario,
-    single_mesh_drive_forces,
-    torsional_mesh_forces,
-)
-from ..physics.motor import pack_drive_parameters
-from .layout import Inertia, TorsionalLayout, reduced_mass_kg
+from ..assembly import Inertia, TorsionalLayout, mesh_parameters_from_scenario, pack_drive_parameters, reduced_mass_kg
+from ..physics.mesh import mesh_contact, single_mesh_drive_forces, torsional_mesh_forces
 
 OVT = exu.OutputVariableType
 HIDDEN = VObjectGenericODE2(show=False)
@@ -63,6 +57,7 @@ class BuiltSystem:
     sensors: dict[str, list[int]] = field(default_factory=dict)  # kind -> one sensor per node
     user_functions: list = field(default_factory=list)  # keep references alive
     fixed_coordinates: list[int] = field(default_factory=list)  # held at 0 (CoordinateConstraint)
+    watchdog: _StallWatchdog = field(default_factory=lambda: _StallWatchdog())  # records a stall
 
 
 def _add_nodes(mbs, masses: list[tuple[str, float]], q0, v0, *, rotational: bool) -> list[int]:
@@ -206,7 +201,7 @@ def build_torsional(
     if not modal:
         D = layout.drive
         if layout.motor_at is not None:
-            built.user_functions.append(_motor_user_function(D))
+            built.user_functions.append(_motor_user_function(D, built.watchdog))
             mbs.AddObject(
                 ObjectGenericODE2(
                     nodeNumbers=[nodes[layout.motor_at]],
@@ -326,7 +321,7 @@ def _add_drive_and_meshes(built: BuiltSystem, layout: TorsionalLayout) -> None:
     """Motor, load and all meshes of a torsional layout as ONE user-function item: one Python call per
     right-hand-side evaluation instead of one per item (Exudyn's per-call overhead dominates the cost)."""
     D = layout.drive
-    watchdog = _StallWatchdog()
+    watchdog = built.watchdog
     if (
         len(layout.meshes) == 1
         and len({layout.motor_at, layout.meshes[0].pinion, layout.meshes[0].wheel, layout.load_at}) == 4
@@ -406,7 +401,8 @@ def _bearing_user_function(law, free_directions: tuple[int, ...]):
 
 
 class StallError(RuntimeError):
-    """Raised from inside a user function when the solver makes no progress in time."""
+    """Raised from inside a user function when the solver makes no progress in time (Exudyn passes it on
+    as its own error; the watchdog's ``failure`` tells the caller what happened)."""
 
 
 STALL_CALLS = 200_000  # right-hand-side evaluations per check (~30k steps: ~0.1 s simulated normally)
@@ -419,6 +415,7 @@ class _StallWatchdog:
 
     def __init__(self) -> None:
         self.calls, self.t_check, self.t_max = 0, -1.0, -1.0
+        self.failure = ""
 
     def __call__(self, t: float) -> None:
         self.calls += 1
@@ -426,18 +423,18 @@ class _StallWatchdog:
             self.t_max = t
         if self.calls % STALL_CALLS == 0:
             if self.t_max - self.t_check < STALL_ADVANCE_S:
-                raise StallError(
+                self.failure = (
                     f"the solver stalled at t = {self.t_max:.9g} s: {STALL_CALLS} force evaluations "
                     f"advanced less than {STALL_ADVANCE_S:g} s (step size collapse at a discontinuity, "
                     "e.g. a tooth with stiffness factor 0 next to a loaded one). Hint: use a small "
                     "non-zero stiffness factor, or loosen solver.relative_tolerance / absolute_tolerance"
                 )
+                raise StallError(self.failure)
             self.t_check = self.t_max
 
 
-def _motor_user_function(D: np.ndarray):
+def _motor_user_function(D: np.ndarray, watchdog: _StallWatchdog):
     """Motor torque (and the stall watchdog)."""
-    watchdog = _StallWatchdog()
 
     def motor_torque(mbs, t, itemNumber, q, q_t):
         watchdog(t)

@@ -17,9 +17,15 @@ import numpy as np
 from exudyn.itemInterface import Node1D, ObjectGenericODE2, ObjectMass1D
 
 from ..model import Scenario
-from ..physics import mean_stiffness_N_per_m, mesh_parameters_from_scenario
+from ..assembly import (
+    TorsionalLayout,
+    mesh_parameters_from_scenario,
+    reduced_mass_kg,
+    static_lateral_displacements_m,
+    torsional_layout,
+)
+from ..physics import mean_stiffness_N_per_m
 from .build import build_torsional
-from .layout import TorsionalLayout, reduced_mass_kg, static_lateral_displacements_m, torsional_layout
 
 
 @dataclass(frozen=True)
@@ -119,7 +125,7 @@ def natural_frequencies(
 
 def scene_modes(scenario: Scenario) -> ModeSet:
     """Modes of a scene at its mean mesh stiffness (healthy teeth)."""
-    if scenario.meta.scene == "muller":
+    if scenario.meta.topology == "muller":
         k_mean = mean_stiffness_N_per_m(mesh_parameters_from_scenario(scenario))
         SC = exu.SystemContainer()
         mbs = SC.AddSystem()

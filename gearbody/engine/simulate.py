@@ -23,17 +23,19 @@ from ..model import Scenario, scenario_to_dict
 from ..physics import load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
 from ..physics.lateral import mesh_directions
-from ..physics.mesh import mesh_contact_series, mesh_parameters_from_scenario, mesh_phase_series
-from ..physics.motor import pack_drive_parameters
-from ..result import Result
-from .build import BuiltSystem, build_muller, build_torsional
-from .layout import (
+from ..assembly import (
     gear_names,
     initial_state,
     mesh_frequency_hz,
+    mesh_parameters_from_scenario,
+    pack_drive_parameters,
     static_lateral_displacements_m,
     torsional_layout,
 )
+from ..errors import SimulationError
+from ..physics.mesh import mesh_contact_series, mesh_phase_series
+from ..result import Result
+from .build import BuiltSystem, build_muller, build_torsional
 from .sampling import OVERSAMPLING, is_band_limited, mesh_jump_times
 
 SOLVER_TYPES = {
@@ -46,10 +48,6 @@ SOLVER_TYPES = {
 MIN_STEP_S = 1e-14
 STALL_CHECKS = 50  # x Monitor.every step attempts
 STALL_PROGRESS_S = 1e-9
-
-
-class SimulationError(RuntimeError):
-    """Numerical failure (non-finite state, divergence, step-size collapse), with the time it happened."""
 
 
 @dataclass
@@ -137,17 +135,11 @@ def solver_settings(scenario: Scenario) -> exu.SimulationSettings:
 
 
 def build(scenario: Scenario) -> tuple[BuiltSystem, np.ndarray, np.ndarray]:
-    """Exudyn system of a scenario at its initial state."""
-    try:
-        q0, v0 = initial_state(scenario)
-    except ValueError as exc:
-        raise SimulationError(f"cannot set the initial state: {exc}") from None
-    if scenario.meta.scene == "muller":
+    """Exudyn system of a scenario at its initial state (an infeasible start raises InputError)."""
+    q0, v0 = initial_state(scenario)
+    if scenario.meta.topology == "muller":
         return build_muller(scenario, q0, v0), q0, v0
-    try:
-        lateral_u0 = static_lateral_displacements_m(scenario)
-    except ValueError as exc:
-        raise SimulationError(f"cannot set the initial bearing displacements: {exc}") from None
+    lateral_u0 = static_lateral_displacements_m(scenario)
     return build_torsional(torsional_layout(scenario), q0, v0, lateral_u0=lateral_u0), q0, v0
 
 
@@ -159,7 +151,7 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
     mbs = built.mbs
     watch = built.nodes[0]
     limit = 100.0 * scenario.design.motor.synchronous_speed_rad_s
-    if scenario.meta.scene == "muller":
+    if scenario.meta.topology == "muller":
         limit = 1e3  # m/s of deflection rate: anything near this is divergence
     monitor = _Monitor(mbs, watch, scenario.operation.t_end_s, limit, progress)
     mbs.SetPreStepUserFunction(monitor)
@@ -173,9 +165,9 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
             mbs, settings, solverType=SOLVER_TYPES[scenario.solver.method], storeSolver=True, showHints=False
         )
     except Exception as exc:  # a user function raised (stall watchdog) or Exudyn failed
+        if built.watchdog.failure:
+            raise SimulationError(built.watchdog.failure) from None
         message = str(exc)
-        if "stalled" in message:
-            raise SimulationError(message[message.index("the solver stalled") :].split("\n")[0]) from None
         last = message.strip().splitlines()[-1] if message.strip() else repr(exc)
         raise SimulationError(f"Exudyn stopped: {last}") from exc
     finally:
@@ -250,7 +242,7 @@ def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
     def states(times):
         return position(times), velocity(times), np.stack([np.interp(times, t_steps, row) for row in a])
 
-    band_limit = scenario.solver.anti_aliasing and scenario.meta.scene != "muller"
+    band_limit = scenario.solver.anti_aliasing and scenario.meta.topology != "muller"
     if band_limit:
         M = _oversampling(scenario, built, v)
         t_fine = np.arange((n_out - 1) * M + 1) / (M * rate)
@@ -258,7 +250,7 @@ def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
     else:
         t = np.arange(n_out) / rate
     signals: dict[str, np.ndarray] = {}
-    if scenario.meta.scene == "muller":
+    if scenario.meta.topology == "muller":
         qs, vs, acc = states(t)
         signals.update(_muller_signals(scenario, t, qs[0], vs[0], acc[0]))
     elif not band_limit:
@@ -272,7 +264,8 @@ def _collect(scenario: Scenario, built: BuiltSystem) -> Result:
         "max_step_s": float(steps.max()) if n_steps else 0.0,
     }
     meta = {
-        "scene": scenario.meta.scene,
+        "scene": scenario.name,
+        "topology": scenario.meta.topology,
         "title": scenario.meta.title,
         "seed": scenario.meta.seed,
         "scenario": scenario_to_dict(scenario),

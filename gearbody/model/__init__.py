@@ -1,52 +1,43 @@
-"""Declarative model: scenario dataclasses (DPTOCC factors), validation and TOML input/output."""
+"""Declarative model: scenario dataclasses (DPTOCC factors), validation, TOML input/output, scenes."""
 
+from ..errors import ScenarioError
+from .components import Bearing, Gear, Machine, Motor, Shaft
+from .faults import DamagedTooth, Eccentricity, ErrorMode, PittedTooth
 from .io import dump_scenario, load_scenario, parse_override, scenario_to_dict
-from .params import ScenarioError
-from .scenario import (
-    SCENES,
-    Bearing,
-    Condition,
-    DamagedTooth,
-    Design,
-    ErrorMode,
-    Gear,
-    Machine,
-    Mesh,
-    Meta,
-    Motor,
-    Operation,
-    Production,
-    Profile,
-    Scenario,
-    Shaft,
-    Solver,
-    Stage,
-    Visual,
-)
+from .mesh import Mesh, MeshGeometry
+from .operation import Operation, Profile, four_periods, steady
+from .scenario import TOPOLOGIES, Condition, Design, Meta, Scenario, Solver, Stage, Visual
+from .scenes import list_scenes, scene_path
 
 __all__ = [
-    "SCENES",
+    "TOPOLOGIES",
+    "Bearing",
     "Condition",
     "DamagedTooth",
     "Design",
+    "Eccentricity",
     "ErrorMode",
-    "Bearing",
     "Gear",
     "Machine",
     "Mesh",
+    "MeshGeometry",
     "Meta",
     "Motor",
     "Operation",
-    "Production",
+    "PittedTooth",
     "Profile",
     "Scenario",
     "ScenarioError",
     "Shaft",
-    "Stage",
     "Solver",
+    "Stage",
     "Visual",
     "dump_scenario",
+    "four_periods",
+    "list_scenes",
     "load_scenario",
     "parse_override",
     "scenario_to_dict",
+    "scene_path",
+    "steady",
 ]

@@ -11,13 +11,12 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import math
+import re
 import types
 import typing
 from typing import Any, get_args, get_origin, get_type_hints
 
-
-class ScenarioError(ValueError):
-    """Invalid scenario input; the message names file, key, value and allowed range."""
+from ..errors import ScenarioError
 
 
 def param(
@@ -36,6 +35,19 @@ def param(
     if default_factory is not dataclasses.MISSING:
         return dataclasses.field(default_factory=default_factory, metadata=meta)
     return dataclasses.field(default=default, metadata=meta)
+
+
+def stage_key(stage: int, key: str = "") -> str:
+    """Dotted key of stage ``stage`` (0-based in Python, numbered from 1 in keys): design.stages.2.mesh."""
+    return f"design.stages.{stage + 1}." + key
+
+
+class Node:
+    """Base of the scenario dataclasses: ``replace(**changes)`` gives a validated copy."""
+
+    def replace(self, **changes: Any):
+        """A copy with ``changes`` (field = new value), validated like a freshly built one."""
+        return dataclasses.replace(self, **changes)
 
 
 def describe_range(meta: typing.Mapping[str, Any]) -> str:
@@ -68,17 +80,40 @@ def _in_range(value: float, meta: typing.Mapping[str, Any]) -> bool:
 
 
 class _Ctx:
-    """Where a value came from: file name and dotted key path, for error messages."""
+    """Where a value came from: file name and dotted key path, for error messages.
 
-    def __init__(self, source: str, path: str = ""):
-        self.source, self.path = source, path
+    ``aliases`` maps canonical key prefixes to the keys the user wrote (the single-stage shorthand:
+    ``design.stages.1.pinion`` was written ``design.pinion``), so that messages name the user's key.
+    """
+
+    def __init__(self, source: str, path: str = "", aliases: typing.Mapping[str, str] | None = None):
+        self.source, self.path, self.aliases = source, path, dict(aliases or {})
 
     def child(self, key: str) -> _Ctx:
-        return _Ctx(self.source, f"{self.path}.{key}" if self.path else key)
+        return _Ctx(self.source, f"{self.path}.{key}" if self.path else key, self.aliases)
+
+    def shown(self, path: str | None = None) -> str:
+        """``path`` (default: this one) as the user wrote it."""
+        return display_path(self.path if path is None else path, self.aliases)
 
     def fail(self, value: Any, message: str) -> typing.NoReturn:
         shown = f"{value:.6g}" if isinstance(value, float) else repr(value)
-        raise ScenarioError(f"{self.source}: {self.path} = {shown}: {message}")
+        raise ScenarioError(f"{self.source}: {self.shown()} = {shown}: {message}")
+
+
+def display_path(path: str, aliases: typing.Mapping[str, str]) -> str:
+    """A canonical dotted key as the user wrote it (longest aliased prefix replaced)."""
+    for canonical in sorted(aliases, key=len, reverse=True):
+        if path == canonical or path.startswith(canonical + "."):
+            return aliases[canonical] + path[len(canonical) :]
+    return path
+
+
+def display_text(text: str, aliases: typing.Mapping[str, str]) -> str:
+    """Every aliased canonical key inside a message, as the user wrote it."""
+    for canonical in sorted(aliases, key=len, reverse=True):
+        text = re.sub(re.escape(canonical) + r"(?=[.\s:;,)']|$)", aliases[canonical], text)
+    return text
 
 
 def _type_name(tp: Any) -> str:
@@ -107,7 +142,8 @@ def _convert(value: Any, tp: Any, ctx: _Ctx, meta: typing.Mapping[str, Any]) -> 
         if not isinstance(value, (list, tuple)):
             ctx.fail(value, "must be a list")
         (item_tp, *_rest) = get_args(tp)
-        return tuple(_convert(v, item_tp, ctx.child(f"[{i}]"), {}) for i, v in enumerate(value))
+        # list items are numbered from 1 in keys (design.stages.2.mesh), as in --set and the signal names
+        return tuple(_convert(v, item_tp, ctx.child(str(i + 1)), {}) for i, v in enumerate(value))
     if tp is bool:
         if not isinstance(value, bool):
             ctx.fail(value, "must be true or false")
@@ -140,11 +176,11 @@ def _from_dict(cls: type, data: typing.Mapping[str, Any], ctx: _Ctx) -> Any:
         if key not in fields:
             near = difflib.get_close_matches(key, list(fields), n=1, cutoff=0.5)
             hint = (
-                f"; did you mean {ctx.child(near[0]).path!r}?"
+                f"; did you mean {ctx.child(near[0]).shown()!r}?"
                 if near
                 else f"; valid keys here: {', '.join(fields)}"
             )
-            raise ScenarioError(f"{ctx.source}: unknown key {ctx.child(key).path!r}{hint}")
+            raise ScenarioError(f"{ctx.source}: unknown key {ctx.child(key).shown()!r}{hint}")
     kwargs = {}
     for name, f in fields.items():
         sub = ctx.child(name)
@@ -152,24 +188,30 @@ def _from_dict(cls: type, data: typing.Mapping[str, Any], ctx: _Ctx) -> Any:
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
                 doc = f.metadata.get("doc", "")
                 raise ScenarioError(
-                    f"{ctx.source}: missing required key {sub.path!r}"
+                    f"{ctx.source}: missing required key {sub.shown()!r}"
                     + (f" ({doc}; {describe_range(f.metadata)})" if doc else "")
                 )
             continue
         kwargs[name] = _convert(data[name], hints[name], sub, f.metadata)
     try:
-        obj = cls(**kwargs)
+        prepare = getattr(cls, "prepare_fields", None)  # e.g. Scenario: resolve gear geometry first
+        return cls(**(prepare(kwargs) if prepare else kwargs))
     except ScenarioError as exc:
-        where = f"[{ctx.path}] " if ctx.path else ""
-        raise ScenarioError(f"{ctx.source}: {where}{exc}") from None
-    return obj
+        where = f"[{ctx.shown()}] " if ctx.path else ""
+        raise ScenarioError(f"{ctx.source}: {where}{display_text(str(exc), ctx.aliases)}") from None
 
 
-def from_dict(cls: type, data: typing.Mapping[str, Any], source: str = "<scenario>") -> Any:
-    """Build dataclass ``cls`` from a nested dict, checking keys, types and ranges."""
+def from_dict(
+    cls: type,
+    data: typing.Mapping[str, Any],
+    source: str = "<scenario>",
+    aliases: typing.Mapping[str, str] | None = None,
+) -> Any:
+    """Build dataclass ``cls`` from a nested dict, checking keys, types and ranges; ``aliases`` name
+    canonical keys as the user wrote them in messages (see :class:`_Ctx`)."""
     if not isinstance(data, dict):
         raise ScenarioError(f"{source}: the scenario must be a table of sections, got {type(data).__name__}")
-    return _from_dict(cls, data, _Ctx(source))
+    return _from_dict(cls, data, _Ctx(source, aliases=aliases))
 
 
 def to_dict(obj: Any) -> Any:

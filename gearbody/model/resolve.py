@@ -9,7 +9,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from .params import ScenarioError
+from .mesh import MESH_DEFAULTS
+from .params import ScenarioError, stage_key
 
 _REL_TOL = 1e-9
 
@@ -128,8 +129,6 @@ def resolve_stage_geometry(pinion, wheel, mesh, where: str):
             where, "stiffness_double_N_per_m", mesh.stiffness_double_N_per_m, double
         )
     elif mesh.stiffness_profile in ("contact-ratio", "table"):
-        from .scenario import MESH_DEFAULTS
-
         for key in ("stiffness_single_N_per_m", "stiffness_double_N_per_m"):
             if getattr(mesh, key) is None:
                 derived[key] = MESH_DEFAULTS[key]
@@ -153,3 +152,38 @@ def resolve_iso_stiffness(mesh, teeth_pinion: int, teeth_wheel: int, rated_force
             where, "stiffness_double_N_per_m", mesh.stiffness_double_N_per_m, double
         ),
     )
+
+
+def resolve_design(design):
+    """The design with every stage's [geometry] resolved: gears and mesh (base radii, contact ratio,
+    pitch point, backlash, stiffness), then the ISO stiffness at each stage's rated force, and the
+    damaged teeth checked against the stiffness profile they need. Pure: returns a new Design."""
+    stages = []
+    for k, st in enumerate(design.stages):
+        p, w, m = resolve_stage_geometry(st.pinion, st.wheel, st.mesh, stage_key(k, "mesh."))
+        stages.append(dataclasses.replace(st, pinion=p, wheel=w, mesh=m))
+    design = dataclasses.replace(design, stages=tuple(stages))
+    for k, st in enumerate(design.stages):
+        where = stage_key(k, "mesh.")
+        if st.mesh.stiffness_profile == "iso-6336-b":
+            mesh = resolve_iso_stiffness(
+                st.mesh, st.pinion.teeth, st.wheel.teeth, design.stage_rated_force_N(k), where
+            )
+            stages[k] = dataclasses.replace(st, mesh=mesh)
+        for tooth in st.damaged_teeth:
+            if tooth.has_geometric_damage and st.mesh.stiffness_profile != "potential-energy":
+                raise ScenarioError(
+                    f"{stage_key(k, 'damaged_teeth')}: {tooth.gear} tooth {tooth.tooth} has a crack, breakage "
+                    f"or spall; these need {where}stiffness_profile = 'potential-energy' (got "
+                    f"{st.mesh.stiffness_profile!r})"
+                )
+        if st.mesh.stiffness_profile == "potential-energy" and any(
+            t.has_geometric_damage for t in st.damaged_teeth
+        ):
+            from ..physics.mesh_stiffness import stage_pair_table
+
+            try:
+                stage_pair_table(st)
+            except ValueError as exc:
+                raise ScenarioError(f"{stage_key(k, 'damaged_teeth')}: {exc}") from None
+    return dataclasses.replace(design, stages=tuple(stages))

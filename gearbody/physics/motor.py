@@ -56,24 +56,6 @@ def viscous_equivalent_Nms(
 #                 load t.., load f..]
 
 
-def pack_drive_parameters(scenario) -> np.ndarray:
-    """Motor and load parameters with the speed and load profiles, as one float64 array."""
-    m, op = scenario.design.motor, scenario.operation
-    st, sf = np.asarray(op.speed_profile.time_s, float), np.asarray(op.speed_profile.fraction, float)
-    lt, lf = np.asarray(op.load_profile.time_s, float), np.asarray(op.load_profile.fraction, float)
-    head = np.array(
-        [
-            m.synchronous_speed_rad_s,
-            m.breakdown_torque_Nm,
-            m.breakdown_slip,
-            scenario.design.machine.rated_torque_Nm,
-            st.size,
-            lt.size,
-        ]
-    )
-    return np.concatenate([head, st, sf, lt, lf])
-
-
 @njit(cache=True)
 def _speed_profile(D):
     n = int(D[4])

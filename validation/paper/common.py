@@ -3,7 +3,7 @@
 Each script ``figs_*.py`` checks the paper's claims for one figure group with ONE documented
 parameter set per system (the shipped scenes; nothing is tuned per claim) and writes
 ``validation/paper/results/<name>.md`` (claims table) and its figures next to it.
-``python -m gearbody.validation.paper.run_all`` runs them all and regenerates RESULTS.md.
+``python -m gearbody_validation.paper.run_all`` runs them all and regenerates RESULTS.md.
 """
 
 from __future__ import annotations
@@ -13,7 +13,16 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
+def _output_dir() -> Path:
+    """validation/paper of the checkout the command runs in (RESULTS.md belongs there), else this
+    package's own folder (an editable install is the checkout)."""
+    here = Path.cwd() / "validation" / "paper"
+    if (Path.cwd() / "pyproject.toml").is_file() and (here / "run_all.py").is_file():
+        return here
+    return Path(__file__).resolve().parent
+
+
+HERE = _output_dir()
 RESULTS_DIR = HERE / "results"
 
 

@@ -5,7 +5,7 @@ shaft, machine), rated speed and load, steady running, friction as in the scene.
 grows linearly with e up to a threshold e that depends on a; above it the running is unstable
 (tooth separation, K_d > 2).
 
-    python -m gearbody.validation.paper.fig_09 [--quick]
+    python -m gearbody_validation.paper.fig_09 [--quick]
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ System: the shipped `one-stage` scene as it is (its operation section is the fou
 0-0.5 s, no load to 0.8 s, load ramp to 1.2 s, rated load to 2.0 s); only the error mode and the
 coupling damping C_1 change per case, as in the paper.
 
-    python -m gearbody.validation.paper.fig_12 [--quick]
+    python -m gearbody_validation.paper.fig_12 [--quick]
 """
 
 from __future__ import annotations

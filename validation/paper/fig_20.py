@@ -6,7 +6,7 @@ random-error shaft orders do not fill the band) and no friction (friction also e
 its own f_z). A control run has a silent second stage (constant stiffness, no error). Signal: angular
 acceleration of the intermediate shaft's first-stage wheel (band-limited), Hann window.
 
-    python -m gearbody.validation.paper.fig_20
+    python -m gearbody_validation.paper.fig_20
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ error mode E(0.5, 10, 0) as in Figs. 6-7, rated load, steady running. Its mesh m
 (`gearbody modes two-wheel`), so the mesh frequency meets it at 0.868 of the synchronous speed.
 Speeds: 0.6 (under), resonance, 1.3 (over); and a sweep of K_d against speed for the resonance map.
 
-    python -m gearbody.validation.paper.figs_06_08 [--quick]
+    python -m gearbody_validation.paper.figs_06_08 [--quick]
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ System: the shipped `one-stage` scene, steady rated running, E(0.5, 10, 0), pini
 pinion's angular acceleration (band-limited), averaged synchronously over pinion revolutions using
 the simulated pinion angle.
 
-    python -m gearbody.validation.paper.figs_10_11
+    python -m gearbody_validation.paper.figs_10_11
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ mesh stiffness, the damaged tooth's pair weakened over its whole contact): a 6 m
 0.8 k_z, 40 % / 80 % of the face width broken off for 0.6 / 0.2, the whole tooth broken off for 0.0
 (validation/paper/faults.py, GEOMETRIC_DAMAGE).
 
-    python -m gearbody.validation.paper.figs_13_16
+    python -m gearbody_validation.paper.figs_13_16
 """
 
 from __future__ import annotations

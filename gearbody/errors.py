@@ -1,0 +1,62 @@
+"""One error hierarchy for gearbody: every failure a user can meet is a :class:`GearbodyError`, and the
+command line maps its type to an exit code (never its message text).
+
+Physics (``gearbody.physics``) sits below this module and raises its own
+:class:`gearbody.physics.exceptions.PhysicsError`; the model wraps it into a :class:`ScenarioError`.
+"""
+
+from __future__ import annotations
+
+
+class GearbodyError(Exception):
+    """Base of every gearbody error; ``exit_code`` is what the command line returns for it."""
+
+    exit_code = 1
+
+
+class InputError(GearbodyError, ValueError):
+    """Bad input found before anything runs (exit code 2): the message names the key, value and range."""
+
+    exit_code = 2
+
+
+class ScenarioError(InputError):
+    """Invalid scenario input; the message names file, key, value and allowed range."""
+
+
+class SimulationError(GearbodyError, RuntimeError):
+    """Numerical failure of a run (exit code 3): the message names the simulated time and a hint."""
+
+    exit_code = 3
+
+
+class RenderError(InputError):
+    """A picture or animation cannot be made from the given options or result (exit code 2)."""
+
+
+class StudyError(GearbodyError):
+    """A parameter study cannot run as specified (its specification or its store)."""
+
+    exit_code = 2
+
+
+class StudySpecError(StudyError, InputError):
+    """A study specification (--vary, --random, --cases) is invalid (exit code 2)."""
+
+
+class ReferenceMismatch(GearbodyError):
+    """gearbody and the independent reference disagree beyond the validation tolerance (exit code 1)."""
+
+    exit_code = 1
+
+
+__all__ = [
+    "GearbodyError",
+    "InputError",
+    "ReferenceMismatch",
+    "RenderError",
+    "ScenarioError",
+    "SimulationError",
+    "StudyError",
+    "StudySpecError",
+]

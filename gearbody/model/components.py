@@ -1,0 +1,96 @@
+"""Components of a drive: motor, shafts and couplings, gears, bearings, driven machine."""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+from dataclasses import dataclass
+
+from ..physics.bearings import BEARINGS, make_bearing
+from .params import Node, ScenarioError, param
+
+@dataclass(frozen=True, kw_only=True)
+class Motor(Node):
+    """Induction motor with the Kloss characteristic M_s = 2 M_b s s_b / (s^2 + s_b^2)."""
+
+    inertia_kg_m2: float = param(gt=0, doc="rotor inertia I_s")
+    synchronous_speed_rad_s: float = param(gt=0, doc="rated synchronous speed w_s")
+    breakdown_torque_Nm: float = param(gt=0, doc="breakdown (pull-out) torque M_b")
+    breakdown_slip: float = param(gt=0, le=1, doc="breakdown slip s_b")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Shaft(Node):
+    """Torsional spring-damper between two inertias (coupling or shaft)."""
+
+    stiffness_Nm_per_rad: float = param(gt=0, doc="torsional stiffness k")
+    damping_Nms_per_rad: float = param(0.0, ge=0, doc="torsional damping C")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Bearing(Node):
+    """Bearing between a gear centre and the housing: a registered law (gearbody.physics.bearings)
+    with its keyword parameters, and the effective housing mass seen at this bearing."""
+
+    kind: str = param("linear", doc="registered bearing law, e.g. 'linear' or 'hertzian'")
+    housing_mass_kg: float = param(50.0, gt=0, doc="effective housing mass for the housing acceleration")
+    parameters: dict[str, float] = param(default_factory=dict, doc="keyword parameters of the law")
+
+    def __post_init__(self) -> None:
+        law = self.law()  # refuse unknown kinds and bad parameters before anything runs
+        if dataclasses.is_dataclass(law):  # resolve the law's defaults into the scenario
+            resolved = {f.name: float(getattr(law, f.name)) for f in dataclasses.fields(law)}
+            object.__setattr__(self, "parameters", resolved)
+
+    def law(self):
+        """The bearing law object (has ``force_N(displacement_m, velocity_m_s)``)."""
+        if self.kind not in BEARINGS:
+            raise ScenarioError(
+                f"bearing.kind = {self.kind!r}: not a registered bearing law; registered: "
+                f"{', '.join(sorted(BEARINGS))}"
+            )
+        try:
+            return make_bearing(self.kind, **self.parameters)
+        except TypeError as exc:
+            names = list(inspect.signature(BEARINGS[self.kind]).parameters)
+            raise ScenarioError(
+                f"bearing.parameters = {self.parameters}: {exc}; "
+                f"the {self.kind!r} law takes {', '.join(names)}"
+            ) from None
+        except ValueError as exc:
+            raise ScenarioError(f"bearing.parameters: {exc}") from None
+
+
+LATERAL = ("none", "y", "xy")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Gear(Node):
+    teeth: int = param(ge=6, doc="number of teeth z")
+    base_radius_m: float | None = param(
+        None, gt=0, doc="base radius r_b (required unless the mesh has a [geometry] table)"
+    )
+    inertia_kg_m2: float = param(gt=0, doc="polar moment of inertia")
+    mass_kg: float = param(gt=0, doc="mass (lateral models)")
+    lateral: str = param("none", choices=LATERAL, doc="free translations of the gear centre")
+    bearing: Bearing | None = param(None, doc="bearing to the housing (required when lateral)")
+    face_width_m: float | None = param(
+        None, gt=0, le=2, doc="face width b (pictures; from the mesh geometry; unset: 10 modules)"
+    )
+
+    def __post_init__(self) -> None:
+        if self.lateral != "none" and self.bearing is None:
+            raise ScenarioError(
+                f"lateral = {self.lateral!r} needs a bearing table (kind, housing_mass_kg, parameters)"
+            )
+
+    @property
+    def free_directions(self) -> tuple[int, ...]:
+        """Indices (0 = x, 1 = y) of the free centre translations."""
+        return {"none": (), "y": (1,), "xy": (0, 1)}[self.lateral]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Machine(Node):
+    inertia_kg_m2: float = param(gt=0, doc="driven machine inertia I_m")
+    rated_torque_Nm: float = param(gt=0, doc="load torque at rated load on the machine shaft")
