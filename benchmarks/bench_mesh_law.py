@@ -18,8 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
+from gearbody.assembly import mesh_parameters_from_scenario
 from gearbody.model import load_scenario
-from gearbody.physics.mesh import mesh_contact_series, mesh_parameters_from_scenario
+from gearbody.physics.mesh import mesh_contact_series
 
 CASES = {
     "contact-ratio (one-stage)": ("one-stage", []),

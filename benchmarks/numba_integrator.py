@@ -9,9 +9,9 @@ integrates (``one-stage``, and any ``train`` such as ``two-stage``):
 
     I_a phi_a'' = sum of shaft moments + mesh moments + motor torque (motor_at) - load torque (load_at)
 
-built generically from :func:`gearbody.engine.layout.torsional_layout` (inertias; shafts i, j, k, C
+built generically from :func:`gearbody.assembly.torsional_layout` (inertias; shafts i, j, k, C
 with M = k (phi_i - phi_j) + C (phi_i' - phi_j'), -M on i and +M on j, as Exudyn's coordinate spring-
-damper; one mesh per stage) and :func:`gearbody.engine.layout.initial_state`. The force laws are
+damper; one mesh per stage) and :func:`gearbody.assembly.initial_state`. The force laws are
 gearbody's own compiled kernels, called from the compiled loop, so the physics is identical to
 ``gearbody/engine/build.py``: ``torsional_mesh_forces(phi_p, phi_w, w_p, w_w, P)`` on the pinion and
 wheel nodes (``_mesh_user_function``), ``+motor_torque_at(t, w_motor, D)`` on the motor node
@@ -66,7 +66,7 @@ import time
 import numpy as np
 from numba import njit
 
-from gearbody.engine.layout import initial_state, torsional_layout
+from gearbody.assembly import initial_state, torsional_layout
 from gearbody.physics import load_torque_at, motor_torque_at
 from gearbody.physics.mesh import (
     I_A,

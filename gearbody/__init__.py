@@ -6,7 +6,17 @@ diagnostics*, Mechanical Systems and Signal Processing 15(5), 2001.
 
 __version__ = "0.1.0"
 
-from .model import Scenario, ScenarioError, dump_scenario, load_scenario, scenario_to_dict  # noqa: E402
+from .errors import GearbodyError, InputError, ScenarioError, SimulationError  # noqa: E402
+from .model import (  # noqa: E402
+    Operation,
+    Scenario,
+    dump_scenario,
+    four_periods,
+    list_scenes,
+    load_scenario,
+    scenario_to_dict,
+    steady,
+)
 from .result import Result  # noqa: E402
 
 
@@ -20,12 +30,19 @@ def simulate(scenario, *, progress: bool = False) -> Result:
 
 
 __all__ = [
+    "GearbodyError",
+    "InputError",
+    "Operation",
     "Result",
     "Scenario",
     "ScenarioError",
+    "SimulationError",
     "__version__",
     "dump_scenario",
+    "four_periods",
+    "list_scenes",
     "load_scenario",
     "scenario_to_dict",
     "simulate",
+    "steady",
 ]

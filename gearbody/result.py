@@ -53,6 +53,105 @@ class Result:
     def sample_rate_hz(self) -> float:
         return float(self.meta["output_rate_hz"])
 
+    # -- what the run was: scene, stages, teeth --------------------------------------------------
+    @property
+    def name(self) -> str:
+        """The scene's name (``meta.name`` of the scenario)."""
+        return str(self.meta.get("scene", ""))
+
+    @property
+    def n_stages(self) -> int:
+        return len(self.meta.get("stages") or [None])
+
+    @property
+    def stage_names(self) -> list[str]:
+        """``stage 1``, ``stage 2``, ... in power-flow order."""
+        return [f"stage {k + 1}" for k in range(self.n_stages)]
+
+    def teeth(self, stage: int = 0) -> tuple[int, int]:
+        """(z_pinion, z_wheel) of stage ``stage`` (0-based)."""
+        st = self._stage(stage)
+        return int(st["pinion_teeth"]), int(st["wheel_teeth"])
+
+    def stage_signal(self, name: str, stage: int = 0) -> np.ndarray:
+        """Signal ``name`` of stage ``stage``: ``kd`` of stage 2 is ``stage_2_kd``, its pinion angle
+        ``pinion_2_angle_rad``."""
+        self._stage(stage)
+        if stage == 0:
+            return self[name]
+        for gear in ("pinion", "wheel"):
+            if name.startswith(gear + "_"):
+                return self[f"{gear}_{stage + 1}_{name[len(gear) + 1 :]}"]
+        return self[f"stage_{stage + 1}_{name}"]
+
+    def final_window(self, fraction: float = 0.25) -> np.ndarray:
+        """Boolean mask of the last ``fraction`` of the simulated time (the steady period of a run)."""
+        if not 0 < fraction <= 1:
+            raise ValueError(f"fraction = {fraction}: must be > 0 and <= 1")
+        t = self.time_s
+        return t >= t[-1] - fraction * (t[-1] - t[0])
+
+    def mesh_frequency_hz(self, stage: int = 0, fraction: float = 0.25) -> float:
+        """Mean mesh frequency of stage ``stage`` over the final ``fraction`` of the run."""
+        return float(np.mean(self.stage_signal("mesh_frequency_hz", stage)[self.final_window(fraction)]))
+
+    # -- what a diagnostician looks at ------------------------------------------------------------
+    def fold_kd(self, stage: int = 0, bins: int = 100, fraction: float = 0.25):
+        """K_d of stage ``stage`` folded over its mesh period (the paper's Figs. 5-8), from the computed
+        pinion angle, over the final ``fraction`` of the run."""
+        from .analysis import fold_over_mesh_period
+
+        win = self.final_window(fraction)
+        kd = self.stage_signal("kd", stage)[win]
+        angle = self.stage_signal("pinion_angle_rad", stage)[win]
+        return fold_over_mesh_period(kd, angle, self.teeth(stage)[0], bins=bins)
+
+    def spectrum(
+        self,
+        signal: str | None = None,
+        fraction: float = 0.25,
+        harmonics: int = 6,
+        sidebands: int = 3,
+        min_prominence_db: float = 12.0,
+        max_peaks: int = 40,
+    ):
+        """Labelled amplitude spectrum of ``signal`` (default: the vibration signal of the report) over the
+        final ``fraction`` of the run: a :class:`LabelledSpectrum` with the spectrum and its peaks, each
+        labelled by the drive's shaft orders, mesh harmonics, sidebands and cross-modulation lines."""
+        from .analysis import KinematicSources, amplitude_spectrum, kinematic_lines, label_peaks
+
+        name = signal or self.vibration_signal_name
+        win = self.final_window(fraction)
+        spec = amplitude_spectrum(self[name][win], self.sample_rate_hz, window="hann")
+        f_mesh = self.mesh_frequency_hz(0, fraction)
+        peaks = []
+        f_max = self.sample_rate_hz / 2
+        if f_mesh > 0:
+            f_max = min(f_max, (harmonics + 0.5) * f_mesh)
+            teeth = [self.teeth(k) for k in range(self.n_stages)]
+            sources = KinematicSources.gear_train(f_mesh / teeth[0][0], teeth)
+            lines = kinematic_lines(sources, f_max, harmonics=harmonics, sidebands=sidebands, shaft_orders=30)
+            peaks = label_peaks(
+                spec, lines, tolerance_hz=1.5 * spec.resolution_hz, min_prominence_db=min_prominence_db,
+                max_peaks=max_peaks, f_max_hz=f_max,
+            )
+        return LabelledSpectrum(signal=name, spectrum=spec, peaks=peaks, f_max_hz=f_max)
+
+    @property
+    def vibration_signal_name(self) -> str:
+        """The acceleration an accelerometer would read: the housing acceleration at the first lateral
+        gear's bearing, otherwise the pinion's angular acceleration (Muller: the deflection's)."""
+        for name in ("pinion_housing_accel_y_m_s2", "wheel_housing_accel_y_m_s2"):
+            if name in self and f"{name.split('_housing')[0]}_y_m" in self:
+                return name
+        return "pinion_accel_rad_s2" if "pinion_accel_rad_s2" in self else "deflection_accel_m_s2"
+
+    def _stage(self, stage: int) -> dict[str, Any]:
+        stages = self.meta.get("stages") or []
+        if not 0 <= stage < len(stages):
+            raise IndexError(f"stage {stage}: the result has {len(stages)} stage(s), 0..{len(stages) - 1}")
+        return stages[stage]
+
     def save_npz(self, path: str | Path) -> Path:
         """Named arrays (``time`` and ``time_s``, every signal) plus the metadata as JSON in ``meta_json``."""
         path = Path(path)
@@ -66,6 +165,32 @@ class Result:
             meta = json.loads(str(data["meta_json"])) if "meta_json" in data else {}
             signals = {k: data[k] for k in data.files if k not in ("time", "time_s", "meta_json")}
             return cls(time_s=data["time_s"], signals=signals, meta=meta)
+
+
+@dataclass(frozen=True)
+class LabelledSpectrum:
+    """An amplitude spectrum with its prominent peaks labelled by the drive's kinematic lines."""
+
+    signal: str
+    spectrum: Any  # gearbody.analysis.Spectrum
+    peaks: list
+    f_max_hz: float
+
+    def table(self, max_rows: int | None = 20) -> str:
+        """The peaks as a text table (frequency, amplitude, labels)."""
+        from .analysis import peaks_table
+
+        return peaks_table(self.peaks, max_rows=max_rows)
+
+    def plot(self, ax=None, title: str | None = None):
+        """The spectrum with its labelled peaks (matplotlib axes; a new figure when ``ax`` is None)."""
+        from .analysis import plot_labelled_spectrum
+
+        unit = "rad/s^2" if self.signal.endswith("rad_s2") else "m/s^2"
+        return plot_labelled_spectrum(
+            self.spectrum, self.peaks, ax=ax, title=title or f"spectrum of {self.signal}", unit=unit,
+            f_max_hz=self.f_max_hz,
+        )
 
 
 def _jsonable(obj: Any) -> Any:

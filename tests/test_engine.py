@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import gearbody as gb
-from gearbody.engine import SimulationError, simulate
+from gearbody.engine import simulate
 from gearbody.errors import InputError
 from gearbody.model import load_scenario
 

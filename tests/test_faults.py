@@ -5,12 +5,12 @@ import math
 import numpy as np
 import pytest
 
+from gearbody.assembly import mesh_parameters_from_scenario
 from gearbody.model import ScenarioError, load_scenario
 from gearbody.physics.mesh import (
     mesh_breakpoint_phases,
     mesh_contact,
     mesh_error_m,
-    mesh_parameters_from_scenario,
 )
 
 QUIET = ["production.error_mode={a=0.5,e_um=0.0,r=0.0}", "condition.friction_coefficient=0.0"]

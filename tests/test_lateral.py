@@ -10,11 +10,12 @@ import numpy as np
 import pytest
 import scipy.linalg
 
+from gearbody.assembly import mesh_parameters_from_scenario
 from gearbody.engine import scene_modes, simulate
 from gearbody.model import ScenarioError, load_scenario, scenario_to_dict
 from gearbody.physics.bearings import BEARINGS, HertzianBearing, LinearBearing, register_bearing
 from gearbody.physics.lateral import mesh_directions, static_bearing_displacement_m
-from gearbody.physics.mesh import mean_stiffness_N_per_m, mesh_parameters_from_scenario
+from gearbody.physics.mesh import mean_stiffness_N_per_m
 
 STEADY = [
     'operation.initial_state="steady"',
@@ -26,8 +27,8 @@ STEADY = [
 def _hand_matrices(scenario):
     """M and K of a one-stage lateral scene written out by hand: coordinates
     [motor, pinion x, pinion y, pinion, wheel x, wheel y, wheel, machine], fixed ones dropped."""
-    d = scenario.design
-    p, w, mesh = d.pinion, d.wheel, d.mesh
+    d, st = scenario.design, scenario.stages[0]
+    p, w, mesh = st.pinion, st.wheel, st.mesh
     names = ["motor", "pinion_x", "pinion_y", "pinion", "wheel_x", "wheel_y", "wheel", "machine"]
     M = np.diag(
         [
@@ -42,7 +43,7 @@ def _hand_matrices(scenario):
         ]
     )
     K = np.zeros((8, 8))
-    k1, k2 = d.coupling.stiffness_Nm_per_rad, d.output_shaft.stiffness_Nm_per_rad
+    k1, k2 = (sh.stiffness_Nm_per_rad for sh in d.shafts)
     K[np.ix_([0, 3], [0, 3])] += k1 * np.array([[1, -1], [-1, 1]])
     K[np.ix_([6, 7], [6, 7])] += k2 * np.array([[1, -1], [-1, 1]])
     lam = math.radians(mesh.line_of_action_deg)
@@ -131,11 +132,11 @@ def test_steady_start_on_bearings_is_an_equilibrium(scene):
     np.testing.assert_allclose(res["wheel_bearing_force_y_N"], -F, rtol=1e-6)
     np.testing.assert_allclose(res["pinion_bearing_force_x_N"], 0.0, atol=1e-6 * F)
     assert np.ptp(res["pinion_y_m"]) < 1e-6 * abs(res["pinion_y_m"][0])
-    k_y = sc.design.pinion.bearing.parameters.get("stiffness_y_N_per_m")
+    k_y = sc.stages[0].pinion.bearing.parameters.get("stiffness_y_N_per_m")
     if k_y:
         assert res["pinion_y_m"][0] == pytest.approx(F / k_y, rel=1e-9)
     np.testing.assert_allclose(
-        res["wheel_housing_accel_y_m_s2"], -F / sc.design.wheel.bearing.housing_mass_kg, rtol=1e-6
+        res["wheel_housing_accel_y_m_s2"], -F / sc.stages[0].wheel.bearing.housing_mass_kg, rtol=1e-6
     )
 
 
@@ -202,7 +203,7 @@ def test_a_user_bearing_law_runs_without_touching_the_engine():
         base = load_scenario("lateral-8dof", [*STEADY, "operation.t_end_s=0.01", *tight])
         data = scenario_to_dict(base)
         for gear in ("pinion", "wheel"):
-            b = data["design"][gear]["bearing"]
+            b = data["design"]["stages"][0][gear]["bearing"]
             k, c = b["parameters"]["stiffness_x_N_per_m"], b["parameters"]["damping_x_Ns_per_m"]
             b["kind"] = "isotropic-test"
             b["parameters"] = {"stiffness_N_per_m": k, "damping_Ns_per_m": c}
@@ -235,7 +236,8 @@ def test_lateral_gear_needs_a_bearing_and_a_lateral_scene():
         load_scenario("one-stage", ['design.pinion.lateral="y"'])
     with pytest.raises(ScenarioError, match="no lateral motion"):
         data = scenario_to_dict(load_scenario("lateral-6dof"))
-        data["meta"]["scene"] = "two-wheel"
+        data["meta"]["topology"] = "two-wheel"
+        data["design"]["shafts"] = []
         load_scenario(data)
 
 

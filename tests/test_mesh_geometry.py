@@ -7,18 +7,18 @@ import math
 
 import numpy as np
 import pytest
-from gearbody.model.scenes import scene_path
 
+from gearbody.assembly import mesh_parameters_from_scenario
 from gearbody.model import ScenarioError, load_scenario, scenario_to_dict
 from gearbody.model.io import read_toml
 from gearbody.model.resolve import pair_geometry
+from gearbody.model.scenes import scene_path
 from gearbody.physics.mesh import (
     I_HALF_DOUBLE,
     effective_stiffness_series,
     mean_stiffness_N_per_m,
     mesh_breakpoint_phases,
     mesh_contact,
-    mesh_parameters_from_scenario,
     pack_mesh_parameters,
     stiffness_at_phase,
 )

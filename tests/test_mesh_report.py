@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from gearbody import mesh_report as mr
+from gearbody.assembly import mesh_parameters_from_scenario
 from gearbody.cli import main
 from gearbody.model import load_scenario
-from gearbody.physics.mesh import mean_stiffness_N_per_m, mesh_parameters_from_scenario
+from gearbody.physics.mesh import mean_stiffness_N_per_m
 
 CRACK = 'condition.damaged_teeth=[{gear="pinion",tooth=0,crack_depth_mm=2.0}]'
 

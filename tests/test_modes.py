@@ -6,10 +6,17 @@ import numpy as np
 import pytest
 import scipy.linalg
 
+from gearbody.assembly import (
+    Inertia,
+    MeshLink,
+    ShaftLink,
+    TorsionalLayout,
+    mesh_parameters_from_scenario,
+    reduced_mass_kg,
+)
 from gearbody.engine import natural_frequencies, scene_modes
-from gearbody.engine.layout import Inertia, MeshLink, ShaftLink, TorsionalLayout, reduced_mass_kg
 from gearbody.model import load_scenario
-from gearbody.physics import mean_stiffness_N_per_m, mesh_parameters_from_scenario
+from gearbody.physics import mean_stiffness_N_per_m
 
 
 def chain(J, springs, meshes=()):
@@ -49,16 +56,16 @@ def test_branched_geared_system_through_a_stiff_mesh_connector():
 
 def test_scene_modes_equal_eigh_on_hand_built_matrices():
     sc = load_scenario("one-stage")
-    d = sc.design
+    d, st = sc.design, sc.stages[0]
     k = mean_stiffness_N_per_m(mesh_parameters_from_scenario(sc))
-    eps = d.mesh.contact_ratio
+    eps = st.mesh.contact_ratio
     assert k == pytest.approx(
-        (eps - 1) * d.mesh.stiffness_double_N_per_m + (2 - eps) * d.mesh.stiffness_single_N_per_m
+        (eps - 1) * st.mesh.stiffness_double_N_per_m + (2 - eps) * st.mesh.stiffness_single_N_per_m
     )
-    r1, r2 = d.pinion.base_radius_m, d.wheel.base_radius_m
-    k1, k2 = d.coupling.stiffness_Nm_per_rad, d.output_shaft.stiffness_Nm_per_rad
+    r1, r2 = st.pinion.base_radius_m, st.wheel.base_radius_m
+    k1, k2 = (sh.stiffness_Nm_per_rad for sh in d.shafts)
     M = np.diag(
-        [d.motor.inertia_kg_m2, d.pinion.inertia_kg_m2, d.wheel.inertia_kg_m2, d.machine.inertia_kg_m2]
+        [d.motor.inertia_kg_m2, st.pinion.inertia_kg_m2, st.wheel.inertia_kg_m2, d.machine.inertia_kg_m2]
     )
     K = np.array(
         [
@@ -75,7 +82,7 @@ def test_scene_modes_equal_eigh_on_hand_built_matrices():
     # two-wheel: rigid shafts, motor and machine lumped with the gears
     sc2 = load_scenario("two-wheel")
     M2 = np.diag(
-        [d.motor.inertia_kg_m2 + d.pinion.inertia_kg_m2, d.wheel.inertia_kg_m2 + d.machine.inertia_kg_m2]
+        [d.motor.inertia_kg_m2 + st.pinion.inertia_kg_m2, st.wheel.inertia_kg_m2 + d.machine.inertia_kg_m2]
     )
     K2 = k * np.array([[r1**2, -r1 * r2], [-r1 * r2, r2**2]])
     assert scene_modes(sc2).frequencies_hz[1] == pytest.approx(eigh_hz(M2, K2)[1], rel=1e-6)

@@ -102,12 +102,13 @@ def test_tooth_in_mesh_sits_on_the_centre_line(sense):
 
 def test_damaged_and_pitted_teeth_are_coloured():
     sc = load_scenario("one-stage")
-    cond = dataclasses.replace(
-        sc.condition,
-        damaged_teeth=(DamagedTooth(gear="pinion", tooth=3, stiffness_factor=0.5),),
-        pitted_teeth=(PittedTooth(gear="wheel", tooth=7, depth_um=20.0, start_phase=0.2, end_phase=0.4),),
+    layout = build_layout(
+        sc.with_stage(
+            0,
+            damaged_teeth=(DamagedTooth(gear="pinion", tooth=3, stiffness_factor=0.5),),
+            pitted_teeth=(PittedTooth(gear="wheel", tooth=7, depth_um=20.0, start_phase=0.2, end_phase=0.4),),
+        )
     )
-    layout = build_layout(dataclasses.replace(sc, condition=cond))
     p, w = _gear(layout, "pinion"), _gear(layout, "wheel")
     assert p.marked_teeth == ((tooth_angle_rad("pinion", 3, 29, -1, 0.0), DAMAGED),)
     assert w.marked_teeth == ((tooth_angle_rad("wheel", 7, 88, 1, 0.0), PITTED),)
@@ -209,7 +210,8 @@ def _with_stage2_line_of_action(sc, deg):
 def test_lateral_train_must_turn_consistently():
     ok = load_scenario("industrial-two-stage")
     assert build_layout(ok).body("pinion_2").sense == -build_layout(ok).body("pinion").sense
-    with pytest.raises(ScenarioError, match=r"stages\[1\].mesh.line_of_action_deg = -90.*counter-clockwise"):
+    message = r"design.stages.2.mesh.line_of_action_deg = -90.*counter-clockwise"
+    with pytest.raises(ScenarioError, match=message):
         _with_stage2_line_of_action(ok, -90.0)
     # torsional trains have no such constraint (no forces on the housing frame)
     _with_stage2_line_of_action(load_scenario("two-stage"), -90.0)

@@ -3,9 +3,9 @@
 import re
 
 import pytest
-from gearbody.model.scenes import list_scenes, scene_path
 
 from gearbody.model import ScenarioError, dump_scenario, load_scenario, parse_override, scenario_to_dict
+from gearbody.model.scenes import list_scenes, scene_path
 
 
 def refused(scene: str, *overrides: str) -> str:

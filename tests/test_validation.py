@@ -24,7 +24,7 @@ def test_comparison_detects_a_model_difference():
     sc = load_scenario("one-stage", [*cases("one-stage")[0].overrides, "operation.t_end_s=0.05"])
     res = simulate(sc)
     other = scenario_to_dict(sc)
-    other["design"]["mesh"]["damping_Ns_per_m"] *= 1.2
+    other["design"]["stages"][0]["mesh"]["damping_Ns_per_m"] *= 1.2
     other["production"]["error_mode"]["e_um"] = 12.0
     ref = simulate_reference(other, t_eval=res.time_s)
     assert np.max(np.abs(res.mesh_force - ref["mesh_force_N"])) / sc.rated_mesh_force_N > 0.005
@@ -43,7 +43,7 @@ def test_bearing_comparison_detects_a_model_difference():
     )
     assert max(same.values()) < 0.01
     other = scenario_to_dict(sc)
-    other["design"]["wheel"]["bearing"]["parameters"]["stiffness_y_N_per_m"] *= 1.1
+    other["design"]["stages"][0]["wheel"]["bearing"]["parameters"]["stiffness_y_N_per_m"] *= 1.1
     changed = bearing_force_errors_percent(res, simulate_reference_lateral(other, t_eval=res.time_s))
     assert changed["wheel_y"] > 1.0
 

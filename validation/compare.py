@@ -46,8 +46,15 @@ STEADY = [
     'operation.initial_state="steady"',
     "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
     "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
-    "production.error_mode={a=0.5,e_um=10.0,r=0.3}",
 ]
+ERROR_MODE = "error_mode={a=0.5,e_um=10.0,r=0.3}"  # E(0.5, 10, 0.3) on every stage
+
+
+def error_mode_overrides(scene: str) -> list[str]:
+    """E(0.5, 10, 0.3) on each stage of the scene (design.stages.N.error_mode)."""
+    from gearbody.model import load_scenario
+
+    return [f"design.stages.{k + 1}.{ERROR_MODE}" for k in range(len(load_scenario(scene).stages))]
 
 
 @dataclass(frozen=True)
@@ -67,7 +74,6 @@ def _run_up(scale: float) -> list[str]:
         'operation.initial_state="rest"',
         f"operation.speed_profile={{time_s=[0.0,{0.3 * scale}],fraction=[0.0,1.0]}}",
         f"operation.load_profile={{time_s=[0.0,{0.45 * scale},{0.7 * scale}],fraction=[0.0,0.0,1.0]}}",
-        "production.error_mode={a=0.5,e_um=10.0,r=0.3}",
     ]
 
 
@@ -76,13 +82,16 @@ def cases(scene: str, short: bool = False) -> list[Case]:
     # Separation: the two-wheel scene's mesh mode (429 Hz) lies just under its rated mesh frequency
     # (494 Hz); the others are run at the speed where the mesh frequency meets their mesh mode.
     sep_speed = SEPARATION_SPEED.get(scene, 5.6)
+    errors = error_mode_overrides(scene)
+    steady = [*STEADY, *errors]
     separation = [
         *STEADY[:1],
         f"operation.speed_profile={{time_s=[0.0],fraction=[{sep_speed}]}}",
         *STEADY[2:],
+        *errors,
     ]
     scale = 0.4 if short else 1.0
-    run_up = _run_up(scale)
+    run_up = [*_run_up(scale), *errors]
     run_up_text = "four periods: run-up, no load, load ramp, rated"
     if scene != "muller":
         # Unloaded (period 2), the torsional models rattle chaotically in the backlash: between
@@ -92,7 +101,7 @@ def cases(scene: str, short: bool = False) -> list[Case]:
         # are validated by the separation cases.
         run_up_text += "; no backlash (with it the unloaded rattle is chaotic)"
     out = [
-        Case("steady", "steady rated running, E(0.5, 10, 0.3)", tuple(STEADY), 0.5, 0.1),
+        Case("steady", "steady rated running, E(0.5, 10, 0.3)", tuple(steady), 0.5, 0.1),
         Case(
             "separation",
             f"tooth separation, speed x{sep_speed}, E(0.5, 10, 0.3)",
@@ -132,12 +141,7 @@ def case_scenario(scene: str, case: Case, short: bool = False):
     scenario = load_scenario(scene, overrides)
     if case.no_backlash:
         data = scenario_to_dict(scenario)
-        meshes = (
-            [st["mesh"] for st in data["design"]["stages"]]
-            if "stages" in data["design"]
-            else [data["design"]["mesh"]]
-        )
-        for mesh in meshes:
+        for mesh in (st["mesh"] for st in data["design"]["stages"]):
             mesh["backlash_um"] = 0.0
             for key in ("thickness_allowance_pinion_um", "thickness_allowance_wheel_um"):
                 mesh.get("geometry", {}).pop(key, None)
@@ -153,8 +157,7 @@ def reference_input(scenario) -> dict:
     from gearbody.physics.mesh_stiffness import stage_pair_table
 
     data = scenario_to_dict(scenario)
-    train = "stages" in data["design"]
-    meshes = [st["mesh"] for st in data["design"]["stages"]] if train else [data["design"]["mesh"]]
+    meshes = [st["mesh"] for st in data["design"]["stages"]]
     for stage, mesh in zip(scenario.stages, meshes, strict=True):
         if stage.mesh.stiffness_profile == "potential-energy":
             table = stage_pair_table(stage)

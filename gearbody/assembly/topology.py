@@ -7,7 +7,6 @@ exactly what it lists. It imports no Exudyn, so it also serves the linearised mo
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np

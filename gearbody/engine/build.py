@@ -35,11 +35,17 @@ from exudyn.itemInterface import (
     VObjectGenericODE2,
 )
 
+from ..assembly import (
+    Inertia,
+    TorsionalLayout,
+    mesh_parameters_from_scenario,
+    pack_drive_parameters,
+    reduced_mass_kg,
+)
 from ..model import Scenario
 from ..physics import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
 from ..physics.lateral import lateral_mesh_forces, tangent_stiffness_N_per_m
-from ..assembly import Inertia, TorsionalLayout, mesh_parameters_from_scenario, pack_drive_parameters, reduced_mass_kg
 from ..physics.mesh import mesh_contact, single_mesh_drive_forces, torsional_mesh_forces
 
 OVT = exu.OutputVariableType

@@ -16,7 +16,6 @@ import exudyn as exu
 import numpy as np
 from exudyn.itemInterface import Node1D, ObjectGenericODE2, ObjectMass1D
 
-from ..model import Scenario
 from ..assembly import (
     TorsionalLayout,
     mesh_parameters_from_scenario,
@@ -24,6 +23,7 @@ from ..assembly import (
     static_lateral_displacements_m,
     torsional_layout,
 )
+from ..model import Scenario
 from ..physics import mean_stiffness_N_per_m
 from .build import build_torsional
 

@@ -19,10 +19,6 @@ from scipy.interpolate import CubicHermiteSpline
 
 from .. import __version__
 from ..analysis.antialias import band_limited_samples
-from ..model import Scenario, scenario_to_dict
-from ..physics import load_torque_at, motor_torque_at, synchronous_angle_at
-from ..physics.bearings import LinearBearing
-from ..physics.lateral import mesh_directions
 from ..assembly import (
     gear_names,
     initial_state,
@@ -33,6 +29,10 @@ from ..assembly import (
     torsional_layout,
 )
 from ..errors import SimulationError
+from ..model import Scenario, scenario_to_dict
+from ..physics import load_torque_at, motor_torque_at, synchronous_angle_at
+from ..physics.bearings import LinearBearing
+from ..physics.lateral import mesh_directions
 from ..physics.mesh import mesh_contact_series, mesh_phase_series
 from ..result import Result
 from .build import BuiltSystem, build_muller, build_torsional

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from ..physics.bearings import BEARINGS, make_bearing
 from .params import Node, ScenarioError, param
 
+
 @dataclass(frozen=True, kw_only=True)
 class Motor(Node):
     """Induction motor with the Kloss characteristic M_s = 2 M_b s s_b / (s^2 + s_b^2)."""

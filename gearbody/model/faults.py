@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 from .params import Node, ScenarioError, param
 
+
 @dataclass(frozen=True, kw_only=True)
 class ErrorMode(Node):
     """Tooth error mode E(a, e, r) of the paper (Fig. 4, eq. 6)."""

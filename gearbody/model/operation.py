@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 from .params import Node, ScenarioError, param
 
+
 @dataclass(frozen=True, kw_only=True)
 class Profile(Node):
     """Piecewise-linear fraction over time, held constant outside the given points."""

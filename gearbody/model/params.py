@@ -46,8 +46,24 @@ class Node:
     """Base of the scenario dataclasses: ``replace(**changes)`` gives a validated copy."""
 
     def replace(self, **changes: Any):
-        """A copy with ``changes`` (field = new value), validated like a freshly built one."""
-        return dataclasses.replace(self, **changes)
+        """A copy with ``changes`` (field = new value): each value is checked against its field's type and
+        range as a value read from a file would be, then the copy is validated like a fresh one."""
+        fields = {f.name: f for f in dataclasses.fields(self)}
+        hints = get_type_hints(type(self))
+        checked = {}
+        for name, value in changes.items():
+            if name not in fields:
+                near = difflib.get_close_matches(name, list(fields), n=1)
+                hint = f"; did you mean {near[0]!r}?" if near else f"; fields: {', '.join(fields)}"
+                raise ScenarioError(f"{type(self).__name__}.replace: no field {name!r}{hint}")
+            if dataclasses.is_dataclass(value) or (
+                isinstance(value, tuple) and value and all(dataclasses.is_dataclass(v) for v in value)
+            ):
+                checked[name] = value  # built (and checked) on its own
+            else:
+                ctx = _Ctx(f"{type(self).__name__}.replace", name)
+                checked[name] = _convert(value, hints[name], ctx, fields[name].metadata)
+        return dataclasses.replace(self, **checked)
 
 
 def describe_range(meta: typing.Mapping[str, Any]) -> str:

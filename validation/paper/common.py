@@ -13,6 +13,7 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+
 def _output_dir() -> Path:
     """validation/paper of the checkout the command runs in (RESULTS.md belongs there), else this
     package's own folder (an editable install is the checkout)."""
