@@ -93,8 +93,8 @@ def static_deflection_m(scenario: Scenario, stage: int, pinion_angle_rad: float,
     k = float(effective_stiffness_series(np.array([pinion_angle_rad]), P)[0])  # the law's k, damage included
     if k <= 0:
         raise InputError(
-            f"operation.initial_state = 'steady': stage {stage + 1}: the teeth in mesh at the start carry no load (stiffness factor 0): "
-            "start from rest"
+            f"operation.initial_state = 'steady': stage {stage + 1}: the teeth in mesh at the start carry no "
+            "load (stiffness factor 0): start from rest"
         )
     st = scenario.stages[stage]
     return force_N / k + st.mesh.backlash_um * 1e-6 - error_m

@@ -143,7 +143,6 @@ def reduced_mass_kg(scenario: Scenario) -> float:
     """Muller's reduced mass along the line of action, m = 1 / (r1^2/I_1p + r2^2/I_2p)."""
     st = scenario.stages[0]
     return 1.0 / (
-        st.pinion.base_radius_m**2 / st.pinion.inertia_kg_m2 + st.wheel.base_radius_m**2 / st.wheel.inertia_kg_m2
+        st.pinion.base_radius_m**2 / st.pinion.inertia_kg_m2
+        + st.wheel.base_radius_m**2 / st.wheel.inertia_kg_m2
     )
-
-

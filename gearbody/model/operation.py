@@ -41,9 +41,7 @@ class Operation(Node):
     )
 
 
-def steady(
-    t_end_s: float, *, speed_fraction: float = 1.0, load_fraction: float = 1.0
-) -> Operation:
+def steady(t_end_s: float, *, speed_fraction: float = 1.0, load_fraction: float = 1.0) -> Operation:
     """Steady running from t = 0: constant fraction of the synchronous speed and of the rated load,
     started at the steady operating point (no run-up transient)."""
     return Operation(

@@ -173,8 +173,8 @@ def resolve_design(design):
         for tooth in st.damaged_teeth:
             if tooth.has_geometric_damage and st.mesh.stiffness_profile != "potential-energy":
                 raise ScenarioError(
-                    f"{stage_key(k, 'damaged_teeth')}: {tooth.gear} tooth {tooth.tooth} has a crack, breakage "
-                    f"or spall; these need {where}stiffness_profile = 'potential-energy' (got "
+                    f"{stage_key(k, 'damaged_teeth')}: {tooth.gear} tooth {tooth.tooth} has a crack, "
+                    f"breakage or spall; these need {where}stiffness_profile = 'potential-energy' (got "
                     f"{st.mesh.stiffness_profile!r})"
                 )
         if st.mesh.stiffness_profile == "potential-energy" and any(

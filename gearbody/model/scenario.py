@@ -29,8 +29,11 @@ TOPOLOGIES = ("muller", "two-wheel", "train")
 
 @dataclass(frozen=True, kw_only=True)
 class Meta(Node):
-    topology: str = param(doc="how the drive is modelled: 'train' (chain of stages and shafts), "
-                          "'two-wheel' (Fig. 2), 'muller' (Fig. 1)", choices=TOPOLOGIES)
+    topology: str = param(
+        doc="how the drive is modelled: 'train' (chain of stages and shafts), "
+        "'two-wheel' (Fig. 2), 'muller' (Fig. 1)",
+        choices=TOPOLOGIES,
+    )
     name: str = param("", doc="scene name (loading a file: its name without .toml)")
     title: str = param("", doc="free text")
     sources: tuple[str, ...] = param((), doc="where the parameter values come from")
@@ -139,7 +142,9 @@ class Scenario(Node):
         """A copy with fields of stage ``stage`` (0-based) replaced, e.g.
         ``with_stage(0, error_mode=sc.stages[0].error_mode.replace(e_um=15))``."""
         if not 0 <= stage < len(self.stages):
-            raise ScenarioError(f"stage {stage}: the drive has {len(self.stages)} stage(s), 0..{len(self.stages) - 1}")
+            raise ScenarioError(
+                f"stage {stage}: the drive has {len(self.stages)} stage(s), 0..{len(self.stages) - 1}"
+            )
         stages = list(self.design.stages)
         stages[stage] = stages[stage].replace(**changes)
         return self.replace(design=self.design.replace(stages=tuple(stages)))

@@ -19,7 +19,9 @@ def scene_dir() -> Path:
         return checkout / "scenes"
     spec = importlib.util.find_spec("gearbody_scenes")
     if spec is None or not spec.submodule_search_locations:
-        raise ScenarioError("the shipped scenes are not installed (package gearbody_scenes); reinstall gearbody")
+        raise ScenarioError(
+            "the shipped scenes are not installed (package gearbody_scenes); reinstall gearbody"
+        )
     return Path(next(iter(spec.submodule_search_locations)))
 
 

@@ -133,7 +133,7 @@ def _drop_empty(tables: dict[str, Any], trains_dump: bool) -> None:
     """Drop shorthand keys that say nothing: empty lists, and in a train dumped by gearbody < 0.2 (which
     wrote every section) the default design.mesh and production.error_mode tables it never used."""
     defaults = {("design", "mesh"): to_dict(Mesh()), ("production", "error_mode"): to_dict(ErrorMode())}
-    for (t, key) in (*STAGE_KEYS, *SHAFT_KEYS):
+    for t, key in (*STAGE_KEYS, *SHAFT_KEYS):
         table = tables[t]
         if not table or key not in table:
             continue
@@ -156,7 +156,9 @@ def _refuse_unknown(tables: dict[str, Any], source: str) -> None:
         for key in table:
             if key not in valid:
                 near = difflib.get_close_matches(key, valid, n=1, cutoff=0.5)
-                hint = f"; did you mean '{t}.{near[0]}'?" if near else f"; valid keys here: {', '.join(valid)}"
+                hint = (
+                    f"; did you mean '{t}.{near[0]}'?" if near else f"; valid keys here: {', '.join(valid)}"
+                )
                 raise ScenarioError(f"{source}: unknown key '{t}.{key}'{hint}")
 
 
