@@ -313,8 +313,8 @@ def cmd_run(args) -> int:
 
 
 def cmd_modes(args) -> int:
+    from .analysis.modal import resonance_speeds_rad_s
     from .engine import scene_modes
-    from .engine.modes import resonance_speeds_rad_s
 
     scenario = _load(args.scene, args.overrides)
     modes = scene_modes(scenario)

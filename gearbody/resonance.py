@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .analysis.dynamic_factor import INSTABILITY_KD, separation_stats
+from .analysis.modal import campbell_lines
 from .model import Scenario, load_scenario, scenario_to_dict
 
 __all__ = [
@@ -122,15 +123,6 @@ def kd_speed_sweep(
         pinion_teeth=scenario.stages[0].pinion.teeth,
         errors=list(cols[7]),
     )
-
-
-def campbell_lines(
-    natural_frequencies_hz: Sequence[float], pinion_teeth: int, harmonics: int = 3
-) -> dict[str, np.ndarray]:
-    """Pinion speeds [rad/s] at which mesh harmonic k meets each natural frequency (rows: k = 1..)."""
-    f = np.asarray(natural_frequencies_hz, float)
-    k = np.arange(1, harmonics + 1)[:, None]
-    return {"harmonic": k.ravel(), "speed_rad_s": 2 * math.pi * f[None, :] / (k * pinion_teeth)}
 
 
 def plot_kd_against_speed(
