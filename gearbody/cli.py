@@ -272,7 +272,8 @@ def cmd_list(_args) -> int:
 def cmd_run(args) -> int:
     from .engine import simulate
     from .model import dump_scenario
-    from .summary import summarize, write_plots
+    from .plotting.run import write_plots
+    from .reports.summary import summarize
 
     overrides = _overrides(args)
     scenario = _load(args.scene, overrides)
@@ -287,7 +288,7 @@ def cmd_run(args) -> int:
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     plots = [] if args.no_plots else write_plots(result, out)
     if args.report:
-        from .report import write_report
+        from .reports.html import write_report
 
         write_report(result, out / "report.html")
     if not args.quiet:
@@ -334,8 +335,8 @@ def cmd_modes(args) -> int:
 
 
 def cmd_mesh(args) -> int:
-    from .mesh_plots import plot_stage
-    from .mesh_report import damage_windows, static_transmission_error, stiffness_cycle, summary_text
+    from .plotting.mesh import plot_stage
+    from .reports.mesh import damage_windows, static_transmission_error, stiffness_cycle, summary_text
 
     scenario = _load(args.scene, args.overrides)
     count = len(scenario.stages)

@@ -1,4 +1,5 @@
-"""Resonance tools: K_d against speed from steady-state runs, and the Campbell diagram.
+"""Resonance tools: K_d against speed from steady-state runs (its plots: gearbody.plotting.kd_speed and
+gearbody.plotting.campbell; the Campbell lines: gearbody.analysis.modal).
 
 ``kd_speed_sweep`` runs the scenario at rated load from its steady state at each speed (a fraction of
 the motor's synchronous speed), discards a settling time and records K_d statistics; the natural
@@ -13,20 +14,15 @@ import math
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
-from .analysis.dynamic_factor import INSTABILITY_KD, separation_stats
-from .analysis.modal import campbell_lines
+from .analysis.dynamic_factor import separation_stats
 from .model import Scenario, load_scenario, scenario_to_dict
 
 __all__ = [
     "SpeedSweep",
-    "campbell_lines",
     "kd_speed_sweep",
-    "plot_campbell",
-    "plot_kd_against_speed",
     "steady_overrides",
 ]
 
@@ -123,71 +119,3 @@ def kd_speed_sweep(
         pinion_teeth=scenario.stages[0].pinion.teeth,
         errors=list(cols[7]),
     )
-
-
-def plot_kd_against_speed(
-    sweep: SpeedSweep, natural_frequencies_hz: Sequence[float], path: str | Path, title: str = ""
-) -> Path:
-    """K_d max / min against mesh frequency, with the natural frequencies as vertical lines."""
-    from .plots import _figure, _save
-
-    fig = _figure((900, 500), 100)
-    ax = fig.add_subplot(1, 1, 1)
-    ok = np.isfinite(sweep.kd_max)
-    ax.plot(sweep.mesh_frequency_hz[ok], sweep.kd_max[ok], "o-", label="K_d max")
-    ax.plot(sweep.mesh_frequency_hz[ok], sweep.kd_min[ok], "s--", label="K_d min")
-    ax.axhline(INSTABILITY_KD, color="red", lw=0.8, ls=":", label=f"K_d = {INSTABILITY_KD:g}")
-    lo, hi = ax.get_xlim()
-    for f in natural_frequencies_hz:
-        if f > 1.0 and lo <= f <= hi:
-            ax.axvline(f, color="grey", lw=0.8, ls="--", label="natural frequency")
-            ax.text(f, ax.get_ylim()[1], f" {f:.0f} Hz", rotation=90, va="top", fontsize=8, color="grey")
-    handles, labels = ax.get_legend_handles_labels()
-    seen = dict(zip(labels, handles, strict=True))
-    ax.legend(seen.values(), seen.keys(), loc="best")
-    ax.set_xlabel("mesh frequency f_z = z1 w / 2 pi [Hz]")
-    ax.set_ylabel("K_d = F / F_rated [-]")
-    ax.set_title(title or "K_d against speed (steady rated load)")
-    ax.grid(alpha=0.3)
-    return _save(fig, path, 100)
-
-
-def plot_campbell(
-    natural_frequencies_hz: Sequence[float],
-    pinion_teeth: int,
-    max_speed_rad_s: float,
-    path: str | Path,
-    harmonics: int = 3,
-    title: str = "",
-    operating_speed_rad_s: float | None = None,
-) -> Path:
-    """Campbell diagram: mesh harmonics k z1 w / 2 pi against pinion speed, natural frequencies as
-    horizontal lines; crossings (resonance speeds) marked."""
-    from .plots import _figure, _save
-
-    fig = _figure((900, 600), 100)
-    ax = fig.add_subplot(1, 1, 1)
-    w = np.linspace(0, max_speed_rad_s, 200)
-    f_top = harmonics * pinion_teeth * max_speed_rad_s / (2 * math.pi)
-    for k in range(1, harmonics + 1):
-        ax.plot(w, k * pinion_teeth * w / (2 * math.pi), label=f"{k} f_z")
-    crossings = campbell_lines(natural_frequencies_hz, pinion_teeth, harmonics)["speed_rad_s"]
-    for j, f in enumerate(natural_frequencies_hz):
-        if f < 1.0 or f > f_top:
-            continue
-        ax.axhline(f, color="grey", lw=0.8, ls="--")
-        ax.text(max_speed_rad_s, f, f" {f:.0f} Hz", va="center", fontsize=8, color="grey")
-        for k in range(harmonics):
-            ws = crossings[k, j]
-            if ws <= max_speed_rad_s:
-                ax.plot(ws, f, "ko", ms=4)
-    if operating_speed_rad_s:
-        ax.axvline(operating_speed_rad_s, color="green", lw=1, label="operating speed")
-    ax.set_xlim(0, max_speed_rad_s)
-    ax.set_ylim(0, f_top)
-    ax.set_xlabel("pinion speed w [rad/s]")
-    ax.set_ylabel("frequency [Hz]")
-    ax.set_title(title or "Campbell diagram")
-    ax.legend(loc="upper left")
-    ax.grid(alpha=0.3)
-    return _save(fig, path, 100)
