@@ -375,7 +375,7 @@ def cmd_validate(args) -> int:
 
 
 def cmd_sweep(args) -> int:
-    from .sweep import SweepSpecError, run_study
+    from .studies import SweepSpecError, run_study
 
     overrides = _overrides(args)
     try:

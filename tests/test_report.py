@@ -11,7 +11,7 @@ from gearbody.model import load_scenario
 from gearbody.plotting.campbell import plot_campbell
 from gearbody.plotting.kd_speed import plot_kd_against_speed
 from gearbody.reports.html import report_sections, write_report
-from gearbody.resonance import kd_speed_sweep, steady_overrides
+from gearbody.studies import kd_speed_sweep, steady_overrides
 
 
 @pytest.fixture(scope="module")

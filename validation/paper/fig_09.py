@@ -17,7 +17,7 @@ import numpy as np
 from gearbody.engine import simulate
 from gearbody.model import load_scenario
 from gearbody.plotting import new_figure, save_figure
-from gearbody.resonance import steady_overrides
+from gearbody.studies import steady_overrides
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
 

@@ -17,7 +17,7 @@ from gearbody.analysis import amplitude_spectrum, sideband_lines
 from gearbody.engine import simulate
 from gearbody.model import load_scenario, scenario_to_dict
 from gearbody.plotting import new_figure, save_figure
-from gearbody.resonance import steady_overrides
+from gearbody.studies import steady_overrides
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
 

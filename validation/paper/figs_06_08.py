@@ -20,7 +20,7 @@ from gearbody.model import load_scenario
 from gearbody.plotting import new_figure, save_figure
 from gearbody.plotting.campbell import plot_campbell
 from gearbody.plotting.kd_speed import plot_kd_against_speed
-from gearbody.resonance import kd_speed_sweep, steady_overrides
+from gearbody.studies import kd_speed_sweep, steady_overrides
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
 

@@ -1,30 +1,28 @@
-"""Resonance tools: K_d against speed from steady-state runs (its plots: gearbody.plotting.kd_speed and
-gearbody.plotting.campbell; the Campbell lines: gearbody.analysis.modal).
+"""K_d against speed from steady-state runs (the paper's section 2, Figs. 5-8), as a study on the
+common executors (:mod:`.executors`).
 
 ``kd_speed_sweep`` runs the scenario at rated load from its steady state at each speed (a fraction of
-the motor's synchronous speed), discards a settling time and records K_d statistics; the natural
-frequencies of ``gearbody modes`` mark where the k-th mesh harmonic meets a mode
-(``k z1 w / 2 pi = f_n``). The paper's claim (section 2, Figs. 5-8): the one-stage system is unstable
-(K_d > 2) when the mesh frequency equals its natural frequency.
+the motor's synchronous speed), discards a settling time and records K_d statistics; one case per
+speed, each running :func:`gearbody.studies.tasks.speed_case`. The natural frequencies of
+``gearbody modes`` mark where the k-th mesh harmonic meets a mode (:mod:`gearbody.analysis.modal`);
+:func:`gearbody.plotting.kd_speed.plot_kd_against_speed` draws the result.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
-from .analysis.dynamic_factor import separation_stats
-from .model import Scenario, load_scenario, scenario_to_dict
+from gearbody.model import Scenario, load_scenario, scenario_to_dict
 
-__all__ = [
-    "SpeedSweep",
-    "kd_speed_sweep",
-    "steady_overrides",
-]
+from .executors import run_jobs
+from .tasks import SPEED_VALUES, speed_case
+
+__all__ = ["SpeedSweep", "kd_speed_sweep", "steady_overrides"]
 
 
 def steady_overrides(speed_fraction: float, t_end_s: float, load_fraction: float = 1.0) -> list[str]:
@@ -66,24 +64,6 @@ class SpeedSweep:
         ]
 
 
-def _one_speed(args) -> tuple:
-    data, fraction, settle_s, record_s = args
-    from .engine import simulate
-
-    scenario = load_scenario(data, steady_overrides(fraction, settle_s + record_s))
-    try:
-        res = simulate(scenario)
-    except Exception as exc:  # a failed speed is reported, the sweep goes on
-        return (fraction, math.nan, math.nan, math.nan, math.nan, math.nan, math.nan, str(exc))
-    window = res.time_s >= settle_s
-    kd = res.kd[window]
-    w = float(np.mean(res["pinion_speed_rad_s"][window]))
-    f_z = float(np.mean(res["mesh_frequency_hz"][window]))
-    sep = separation_stats(res.mesh_force[window], res.time_s[window], kd=kd)
-    return (fraction, w, f_z, float(kd.max()), float(kd.min()), float(np.std(kd)),
-            float(sep.separated_fraction), "")
-
-
 def kd_speed_sweep(
     scenario: Scenario,
     speed_fractions: Sequence[float],
@@ -91,6 +71,7 @@ def kd_speed_sweep(
     settle_s: float = 0.1,
     record_s: float = 0.1,
     workers: int = 1,
+    scheduler: str | Any | None = None,
 ) -> SpeedSweep:
     """K_d at rated load against speed: one steady run per speed fraction.
 
@@ -99,7 +80,11 @@ def kd_speed_sweep(
         speed_fractions: motor speeds as fractions of the synchronous speed (> 0).
         settle_s: simulated time discarded at the start of each run [s].
         record_s: simulated time analysed after it [s].
-        workers: processes to run speeds in parallel (each rebuilds the model).
+        workers: processes to run speeds in parallel (each rebuilds the model); 1: in this process.
+        scheduler: a Dask scheduler address or client: run the speeds on that cluster instead.
+    Raises:
+        ValueError: no speeds, a speed <= 0, or a bad settle/record time.
+        ScenarioError: the scenario does not take the steady-running overrides (before anything runs).
     """
     fractions = [float(f) for f in speed_fractions]
     if not fractions or min(fractions) <= 0:
@@ -107,15 +92,24 @@ def kd_speed_sweep(
     if settle_s < 0 or record_s <= 0:
         raise ValueError(f"settle_s must be >= 0 and record_s > 0, got {settle_s}, {record_s}")
     data = scenario_to_dict(scenario)
-    jobs = [(data, f, settle_s, record_s) for f in fractions]
-    if workers > 1:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            out = list(pool.map(_one_speed, jobs))
-    else:
-        out = [_one_speed(j) for j in jobs]
-    cols = list(zip(*out, strict=True))
+    overrides = [steady_overrides(f, settle_s + record_s) for f in fractions]
+    for ov in overrides:  # every case valid before anything runs (a ScenarioError is raised, not recorded)
+        load_scenario(data, ov)
+    jobs = [(f"speed-{i:04d}", (data, ov, settle_s)) for i, ov in enumerate(overrides)]
+    outcomes = dict(
+        run_jobs(speed_case, jobs, workers=None if scheduler is not None else max(int(workers), 1),
+                 scheduler=scheduler, name="gearbody-speed")
+    )
+    columns: dict[str, list[float]] = {k: [] for k in SPEED_VALUES}
+    errors = []
+    for jid, _ in jobs:
+        outcome = outcomes[jid]
+        for k in SPEED_VALUES:
+            columns[k].append(outcome["values"][k] if outcome["ok"] else math.nan)
+        errors.append("" if outcome["ok"] else outcome["message"])
     return SpeedSweep(
-        *(np.array(c, float) for c in cols[:7]),
+        np.array(fractions, float),
+        *(np.array(columns[k], float) for k in SPEED_VALUES),
         pinion_teeth=scenario.stages[0].pinion.teeth,
-        errors=list(cols[7]),
+        errors=errors,
     )
