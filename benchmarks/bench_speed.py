@@ -194,7 +194,7 @@ def build_times() -> list[str]:
 
 
 def study_speedup(cases: int = 16, t_end: float = 0.1) -> list[str]:
-    from gearbody.sweep import run_study
+    from gearbody.studies import run_study
 
     walls = {}
     for workers in (1, 2):

@@ -48,7 +48,7 @@ def test_run_writes_result_resolved_scenario_summary_and_plots(tmp_path, capsys)
         assert key in summary
     assert summary["simulated_time_s"] == 0.05
     resolved = load_scenario(out / "scenario.toml")
-    assert resolved.production.error_mode.e_um == 12 and resolved.operation.t_end_s == 0.05
+    assert resolved.stages[0].error_mode.e_um == 12 and resolved.operation.t_end_s == 0.05
     for png in ("kd_time.png", "kd_folded.png", "spectrum.png"):
         assert (out / png).stat().st_size > 10_000
     assert "kd_max" in capsys.readouterr().out

@@ -7,11 +7,11 @@ import sys
 import numpy as np
 import pytest
 
-from gearbody import mesh_report as mr
 from gearbody.assembly import mesh_parameters_from_scenario
 from gearbody.cli import main
 from gearbody.model import load_scenario
 from gearbody.physics.mesh import mean_stiffness_N_per_m
+from gearbody.reports import mesh as mr
 
 CRACK = 'condition.damaged_teeth=[{gear="pinion",tooth=0,crack_depth_mm=2.0}]'
 
@@ -170,7 +170,8 @@ def test_cli_refuses_bad_stage_and_load(capsys):
 
 def test_report_is_engine_free(tmp_path):
     code = (
-        "import sys; from gearbody.model import load_scenario; from gearbody.mesh_plots import plot_stage; "
+        "import sys; from gearbody.model import load_scenario; "
+        "from gearbody.plotting.mesh import plot_stage; "
         f"s = load_scenario('one-stage'); plot_stage(s, 0, {str(tmp_path / 'x.png')!r}); "
         "assert 'exudyn' not in sys.modules, 'exudyn imported'"
     )

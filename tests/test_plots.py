@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from gearbody.analysis import amplitude_spectrum, fold_over_mesh_period
-from gearbody.plots import harmonic_labels, plot_kd_folded, plot_kd_time, plot_spectrum
+from gearbody.plotting.result import harmonic_labels, plot_kd_folded, plot_kd_time, plot_spectrum
 
 
 def _check_png(path, size_px):

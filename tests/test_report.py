@@ -5,16 +5,13 @@ import math
 import numpy as np
 import pytest
 
+from gearbody.analysis.modal import campbell_lines
 from gearbody.engine import scene_modes, simulate
 from gearbody.model import load_scenario
-from gearbody.report import report_sections, write_report
-from gearbody.resonance import (
-    campbell_lines,
-    kd_speed_sweep,
-    plot_campbell,
-    plot_kd_against_speed,
-    steady_overrides,
-)
+from gearbody.plotting.campbell import plot_campbell
+from gearbody.plotting.kd_speed import plot_kd_against_speed
+from gearbody.reports.html import report_sections, write_report
+from gearbody.studies import kd_speed_sweep, steady_overrides
 
 
 @pytest.fixture(scope="module")

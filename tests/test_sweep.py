@@ -9,15 +9,23 @@ import sys
 import numpy as np
 import pytest
 
-from gearbody import sweep
 from gearbody.cli import main
 from gearbody.model import ScenarioError, load_scenario
-from gearbody.sweep import Study, SweepSpecError, parse_random, parse_vary, run_study
+from gearbody.studies import (
+    Study,
+    SweepSpecError,
+    executors,
+    parse_random,
+    parse_vary,
+    run_study,
+    runner,
+    store,
+)
 
 SCENE = "two-wheel"  # steady start in its scene file; 0.02 s simulate in ~0.1 s
 T_END = ["operation.t_end_s=0.02"]
 E_UM = "production.error_mode.e_um"
-_real_run_case = sweep.run_case
+_real_run_case = runner.run_case
 OVERLOAD = "operation.load_profile={time_s=[0.0],fraction=[1.0]},{time_s=[0.0],fraction=[5.0]}"
 
 
@@ -122,7 +130,7 @@ def test_bad_spec_is_refused_naming_the_argument(kw, named):
 
 
 def test_a_bad_case_fails_before_anything_runs(tmp_path, monkeypatch):
-    monkeypatch.setattr(sweep, "run_case", lambda *a: pytest.fail("ran"))
+    monkeypatch.setattr(runner, "run_case", lambda *a: pytest.fail("ran"))
     with pytest.raises(ScenarioError, match=r"--vary design.pinion.teeth=29,3: case-0001 .*teeth = 3"):
         run_study(SCENE, vary=["design.pinion.teeth=29,3"], out_dir=tmp_path / "s", progress=False)
     with pytest.raises(ScenarioError, match=r"--vary production.error_mode.e_uum=1,2: .*did you mean"):
@@ -142,7 +150,7 @@ def test_a_grid_writes_every_case_the_csv_and_the_plot(serial):
         summary = json.loads((d / "summary.json").read_text())
         assert summary["status"] == "ok" and summary["overrides"] == [*T_END, f"{E_UM}={e}"]
         assert summary["kd_max"] > 1 and summary["wall_time_s"] > 0 and summary["simulated_time_s"] == 0.02
-        assert load_scenario(d / "scenario.toml").production.error_mode.e_um == e
+        assert load_scenario(d / "scenario.toml").stages[0].error_mode.e_um == e
     spec = json.loads((out / "study.json").read_text())
     assert spec["spec"]["vary"] == {E_UM: ["5", "15"]} and len(spec["cases"]) == 2
     with open(out / "summary.csv") as fh:
@@ -157,14 +165,14 @@ def test_a_grid_writes_every_case_the_csv_and_the_plot(serial):
 
 def test_writes_are_atomic(tmp_path):
     target = tmp_path / "summary.json"
-    sweep._write_json(target, {"a": 1})
+    store.write_json(target, {"a": 1})
 
     def broken(path):
         path.write_text('{"a": 2, "b"')
         raise OSError("disk full")
 
     with pytest.raises(OSError):
-        sweep._atomic_write(target, broken)
+        store.atomic_write(target, broken)
     assert json.loads(target.read_text()) == {"a": 1} and [p.name for p in tmp_path.iterdir()] == [
         target.name
     ]
@@ -177,7 +185,7 @@ def test_rerun_resumes_only_unfinished_cases_and_refuses_another_spec(serial, tm
     kept = (out / "cases" / "case-0000" / "summary.json").stat().st_mtime_ns
     ran = []
     monkeypatch.setattr(
-        sweep, "run_case", lambda base, ov, keep: ran.append(ov) or _real_run_case(base, ov, keep)
+        runner, "run_case", lambda base, ov, keep: ran.append(ov) or _real_run_case(base, ov, keep)
     )
     res = _run(out)
     assert ran == [(*T_END, f"{E_UM}=15")] and res.ran == 1 and res.skipped == 1 and res.all_ok
@@ -202,7 +210,7 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, monkeypatch)
     )
     assert [r["status"] for r in res.rows] == ["ok", "failed"] and not res.all_ok
     error = json.loads((out / "cases" / "case-0001" / "error.json").read_text())
-    assert error["error_type"] == "SimulationError" and "breakdown torque" in error["message"]
+    assert error["error_type"] == "InputError" and "breakdown torque" in error["message"]
     assert error["overrides"][-1] == "operation.load_profile={time_s=[0.0],fraction=[5.0]}"
     assert not (out / "cases" / "case-0001" / "summary.json").exists()
     assert not (out / "cases" / "case-0000" / "result.npz").exists()  # save_results=False
@@ -211,10 +219,10 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, monkeypatch)
     assert rows[1]["status"] == "failed" and "breakdown torque" in rows[1]["error"]
     # resume skips the failed case unless asked to retry it; an exception in a worker is recorded too
     calls = []
-    monkeypatch.setattr(sweep, "run_case", lambda *a: calls.append(a) or _real_run_case(*a))
+    monkeypatch.setattr(runner, "run_case", lambda *a: calls.append(a) or _real_run_case(*a))
     kw = {"vary": [OVERLOAD], "base_overrides": T_END, "workers": 1, "progress": False, "save_results": False}
     assert run_study(SCENE, out_dir=out, **kw).ran == 0 and not calls
-    monkeypatch.setattr(sweep, "run_case", lambda *a: sweep._failure(RuntimeError("boom")))
+    monkeypatch.setattr(runner, "run_case", lambda *a: executors.failure(RuntimeError("boom")))
     again = run_study(SCENE, out_dir=out, retry_failed=True, **kw)
     assert again.ran == 1 and again.n_failed == 1
     assert json.loads((out / "cases" / "case-0001" / "error.json").read_text())["message"] == "boom"

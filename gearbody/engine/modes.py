@@ -4,18 +4,20 @@ The mesh is linearised at its mean stiffness over a mesh period (no backlash, er
 motor and load contribute no stiffness, so a free drive train has one rigid-body mode at 0 Hz.
 Linear bearings enter with their stiffness; nonlinear bearing laws with their tangent stiffness at
 the static displacement under the rated mesh forces. Each mode is labelled by its dominant motion,
-from the share of each coordinate in the mode's kinetic energy (M_ii x_i^2).
+from the share of each coordinate in the mode's kinetic energy (M_ii x_i^2). The engine-free result type
+(:class:`~gearbody.analysis.modal.ModeSet`) and the resonance speeds (Campbell lines) live in
+:mod:`gearbody.analysis.modal`.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import exudyn as exu
 import numpy as np
 from exudyn.itemInterface import Node1D, ObjectGenericODE2, ObjectMass1D
 
+from ..analysis.modal import ModeSet
 from ..assembly import (
     TorsionalLayout,
     mesh_parameters_from_scenario,
@@ -27,51 +29,7 @@ from ..model import Scenario
 from ..physics import mean_stiffness_N_per_m
 from .build import build_torsional
 
-
-@dataclass(frozen=True)
-class ModeSet:
-    """Undamped natural frequencies (ascending) and mode shapes (columns, normalised to max |x| = 1).
-
-    Coordinates are named as in the simulation: rotations by their body ("pinion"), lateral
-    translations with an axis suffix ("pinion_x", "pinion_y"). ``masses`` are the diagonal mass
-    matrix entries (kg m^2 for rotations, kg for translations).
-    """
-
-    frequencies_hz: np.ndarray
-    shapes: np.ndarray
-    dof_names: list[str]
-    mean_mesh_stiffness_N_per_m: tuple[float, ...] = ()  # per mesh, at which the modes were computed
-    masses: np.ndarray | None = None
-
-    def is_rigid_body(self, mode: int) -> bool:
-        """A zero-frequency mode (to round-off: below 1e-5 of the highest frequency)."""
-        return bool(self.frequencies_hz[mode] < 1e-5 * self.frequencies_hz.max())
-
-    def energy_shares(self, mode: int) -> np.ndarray:
-        """Share of each coordinate in the kinetic energy of a mode (sums to 1)."""
-        m = np.ones(len(self.dof_names)) if self.masses is None else self.masses
-        e = m * self.shapes[:, mode] ** 2
-        return e / e.sum()
-
-    def dominant_dof(self, mode: int) -> str:
-        return self.dof_names[int(np.argmax(self.energy_shares(mode)))]
-
-    def label(self, mode: int) -> str:
-        """Dominant motion: 'rigid-body rotation', 'torsional: wheel (71 %)', 'lateral y: pinion (64 %)'.
-
-        Torsional when rotations carry at least half of the kinetic energy; the body or axis named is
-        the coordinate with the largest share within that kind.
-        """
-        if self.is_rigid_body(mode):
-            return "rigid-body rotation"
-        share = self.energy_shares(mode)
-        lateral = np.array([n.endswith(("_x", "_y")) and n[:-2] in self.dof_names for n in self.dof_names])
-        kind_mask = lateral if share[lateral].sum() > 0.5 else ~lateral
-        i = int(np.argmax(np.where(kind_mask, share, -1.0)))
-        name = self.dof_names[i]
-        if lateral[i]:
-            return f"lateral {name[-1]}: {name[:-2]} ({100 * share[i]:.0f} %)"
-        return f"torsional: {name} ({100 * share[i]:.0f} %)"
+__all__ = ["ModeSet", "natural_frequencies", "scene_modes"]
 
 
 def _eigen(mbs: exu.MainSystem, fixed: list[int] | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -142,14 +100,3 @@ def scene_modes(scenario: Scenario) -> ModeSet:
     return natural_frequencies(
         torsional_layout(scenario), lateral_u0=static_lateral_displacements_m(scenario, 1.0)
     )
-
-
-def resonance_speeds_rad_s(modes: ModeSet, pinion_teeth: int, harmonics: int = 1) -> np.ndarray:
-    """Pinion speeds at which the k-th mesh harmonic meets each non-zero natural frequency.
-
-    Returns an array of shape (harmonics, n_modes): w = 2 pi f_n / (k z1); NaN for rigid-body modes.
-    """
-    rigid = np.array([modes.is_rigid_body(m) for m in range(len(modes.frequencies_hz))], bool)
-    f = np.where(rigid, np.nan, modes.frequencies_hz)
-    k = np.arange(1, harmonics + 1)[:, None]
-    return 2 * math.pi * f[None, :] / (k * pinion_teeth)

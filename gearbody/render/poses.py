@@ -13,12 +13,9 @@ import math
 
 import numpy as np
 
+from ..errors import RenderError  # bad render request: option, value and what is allowed
 from ..result import Result
 from .layout import Layout
-
-
-class RenderError(ValueError):
-    """Bad render request: names the option, its value and what is allowed."""
 
 
 def frame_times(

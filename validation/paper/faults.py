@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from gearbody.engine import simulate
 from gearbody.model import load_scenario
-from gearbody.resonance import steady_overrides
+from gearbody.studies import steady_overrides
 
 SETTLE_S = 0.1
 BROKEN_TOOTH = 5  # pinion tooth; not tooth 0, which carries the steady start

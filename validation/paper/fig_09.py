@@ -16,8 +16,8 @@ import numpy as np
 
 from gearbody.engine import simulate
 from gearbody.model import load_scenario
-from gearbody.plots import _figure, _save
-from gearbody.resonance import steady_overrides
+from gearbody.plotting import new_figure, save_figure
+from gearbody.studies import steady_overrides
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
 
@@ -57,7 +57,7 @@ def main(quick: bool = False) -> None:
             curves[label] = np.array([kd_max(a, sign * e) for e in e_values])
             print(label, np.round(curves[label], 3))
 
-    fig = _figure((900, 500), 100)
+    fig = new_figure((900, 500), 100)
     ax = fig.add_subplot(1, 1, 1)
     claims, notes = [], []
     thresholds = {}
@@ -99,7 +99,7 @@ def main(quick: bool = False) -> None:
     ax.grid(alpha=0.3)
     ax.legend()
     RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    figs = [_save(fig, RESULTS_DIR / "fig_09_kd_vs_e.png", 100)]
+    figs = [save_figure(fig, RESULTS_DIR / "fig_09_kd_vs_e.png", 100)]
     e_list = ", ".join(f"{e:.0f}" for e in e_values)
     notes.append(f"e values {e_list} um; settle {SETTLE_S} s, record {RECORD_S} s.")
     write_results("fig_09", "Fig. 9: K_d against the error e", claims, notes, figs, timer.s)

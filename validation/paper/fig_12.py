@@ -16,7 +16,7 @@ import numpy as np
 
 from gearbody.engine import simulate
 from gearbody.model import load_scenario
-from gearbody.plots import _figure, _save
+from gearbody.plotting import new_figure, save_figure
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
 
@@ -50,7 +50,7 @@ def main(quick: bool = False) -> None:
             kd4[label] = float(np.max(res.kd[res.time_s >= PERIOD_4_S]))
             traces[label] = (res.time_s[::10], res.kd[::10])
             print(label, round(kd4[label], 3))
-    fig = _figure((1000, 900), 100)
+    fig = new_figure((1000, 900), 100)
     for n, (label, (t, kd)) in enumerate(traces.items()):
         ax = fig.add_subplot(3, 2, n + 1)
         ax.plot(t, kd, lw=0.5)
@@ -61,7 +61,7 @@ def main(quick: bool = False) -> None:
         ax.set_xlabel("t [s]", fontsize=8)
         ax.set_ylabel("K_d", fontsize=8)
     RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    figs = [_save(fig, RESULTS_DIR / "fig_12_runs.png", 100)]
+    figs = [save_figure(fig, RESULTS_DIR / "fig_12_runs.png", 100)]
     k = list(kd4.values())
     claims = []
     for label, (*_, paper) in CASES.items():

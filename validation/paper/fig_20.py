@@ -16,8 +16,8 @@ import numpy as np
 from gearbody.analysis import amplitude_spectrum, sideband_lines
 from gearbody.engine import simulate
 from gearbody.model import load_scenario, scenario_to_dict
-from gearbody.plots import _figure, _save
-from gearbody.resonance import steady_overrides
+from gearbody.plotting import new_figure, save_figure
+from gearbody.studies import steady_overrides
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
 
@@ -51,7 +51,7 @@ def main() -> None:
     with Timer() as timer:
         sp, lines, f_z1, f_z2 = run(True)
         sp0, lines0, _, _ = run(False)
-    fig = _figure((1100, 700), 100)
+    fig = new_figure((1100, 700), 100)
     for n, (title, s, ls) in enumerate((("both stages excited", sp, lines),
                                         ("control: second stage silent", sp0, lines0))):
         ax = fig.add_subplot(2, 1, n + 1)
@@ -64,7 +64,7 @@ def main() -> None:
         ax.set_ylabel("rad/s^2")
     ax.set_xlabel("frequency [Hz]")
     RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    figs = [_save(fig, RESULTS_DIR / "fig_20_spectrum.png", 100)]
+    figs = [save_figure(fig, RESULTS_DIR / "fig_20_spectrum.png", 100)]
     claims = []
     res_hz = sp.resolution_hz
     for label in ("f_z1-f_z2", "f_z1+f_z2", "2f_z1-f_z2", "2f_z1+f_z2", "f_z1-2f_z2", "f_z1+2f_z2"):

@@ -17,8 +17,10 @@ import numpy as np
 from gearbody.analysis import fold_over_mesh_period
 from gearbody.engine import scene_modes, simulate
 from gearbody.model import load_scenario
-from gearbody.plots import _figure, _save
-from gearbody.resonance import kd_speed_sweep, plot_campbell, plot_kd_against_speed, steady_overrides
+from gearbody.plotting import new_figure, save_figure
+from gearbody.plotting.campbell import plot_campbell
+from gearbody.plotting.kd_speed import plot_kd_against_speed
+from gearbody.studies import kd_speed_sweep, steady_overrides
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
 
@@ -48,7 +50,7 @@ def main(quick: bool = False) -> None:
         sweep = kd_speed_sweep(base, fractions, settle_s=SETTLE_S, record_s=RECORD_S / 2)
 
     RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    fig = _figure((900, 500), 100)
+    fig = new_figure((900, 500), 100)
     ax = fig.add_subplot(1, 1, 1)
     for label, f in folded.items():
         ax.plot(f.percent_of_period, f.maximum, label=f"{label}: max over the record")
@@ -59,7 +61,7 @@ def main(quick: bool = False) -> None:
     ax.set_title("two-wheel, E(0.5, 10, 0): K_d over the mesh period (max and min per phase)")
     ax.legend()
     ax.grid(alpha=0.3)
-    figs = [_save(fig, RESULTS_DIR / "figs_06_08_folded.png", 100)]
+    figs = [save_figure(fig, RESULTS_DIR / "figs_06_08_folded.png", 100)]
     figs.append(plot_kd_against_speed(sweep, modes.frequencies_hz, RESULTS_DIR / "figs_06_08_kd_speed.png",
                                       "two-wheel, E(0.5, 10, 0): K_d against speed, rated load"))
     figs.append(plot_campbell(modes.frequencies_hz, z1, 1.6 * rated, RESULTS_DIR / "figs_06_08_campbell.png",

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from gearbody.analysis import condition_indicators_from_average, synchronous_average
-from gearbody.plots import _figure, _save
+from gearbody.plotting import new_figure, save_figure
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
 from .faults import BROKEN_TOOTH, tooth_run
@@ -37,7 +37,7 @@ def main() -> None:
     # tooth n is in mesh while u = z1 phi / 2 pi is in [n, n + 1): pinion angle 360 (n + 0.5) / z1 mid-mesh
     tooth_deg = 360.0 * (BROKEN_TOOTH + 0.5) / z1
     pitch = 360.0 / z1
-    fig = _figure((1000, 800), 100)
+    fig = new_figure((1000, 800), 100)
     for n, (label, avg) in enumerate(tsa.items()):
         ax = fig.add_subplot(3, 1, n + 1)
         ax.plot(np.degrees(avg.angle_rad), avg.average, lw=0.7)
@@ -52,7 +52,7 @@ def main() -> None:
     ax.set_xlabel("pinion angle [deg]")
     ax.legend(fontsize=8)
     RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    figs = [_save(fig, RESULTS_DIR / "figs_10_11_tsa.png", 100)]
+    figs = [save_figure(fig, RESULTS_DIR / "figs_10_11_tsa.png", 100)]
     fm4_b = ind["broken tooth (0.2 k_z)"]["fm4"]
     rms_h = float(np.std(tsa["healthy"].difference()))
     rms_b = float(np.std(diff))

@@ -20,7 +20,7 @@ import numpy as np
 
 from gearbody.analysis import amplitude_spectrum
 from gearbody.engine import SimulationError
-from gearbody.plots import _figure, _save
+from gearbody.plotting import new_figure, save_figure
 
 from .common import RESULTS_DIR, Claim, Timer, write_results
 from .faults import GEOMETRIC_DAMAGE, damaged_tooth_run, tooth_run
@@ -73,7 +73,7 @@ def run_series(runs: dict) -> tuple[dict, dict, dict, dict, dict]:
 
 
 def _plot(spectra: dict, wideband: dict, lines: dict, path):
-    fig = _figure((1000, 1100), 100)
+    fig = new_figure((1000, 1100), 100)
     for n, (label, sp) in enumerate(spectra.items()):
         ax = fig.add_subplot(len(spectra), 1, n + 1)
         keep = sp.frequency_hz <= 4.5 * lines[label][0]
@@ -82,7 +82,7 @@ def _plot(spectra: dict, wideband: dict, lines: dict, path):
         ax.set_ylabel("rad/s^2", fontsize=8)
         ax.set_ylim(bottom=1e-2)
     ax.set_xlabel("frequency [Hz]")
-    return _save(fig, path, 100)
+    return save_figure(fig, path, 100)
 
 
 def _claims(series: str, wideband: dict, share: dict, lines: dict, failed: dict) -> list:

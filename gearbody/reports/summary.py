@@ -1,20 +1,19 @@
 """What a diagnostician reads first about a run: K_d, separation, mesh frequency, speed. Engine-free.
 
 "Final" values are taken over the last quarter of the simulated time (the steady, rated-load
-period in the scenes' four-period operation); whole-run values say so in their name.
+period in the scenes' four-period operation); whole-run values say so in their name. The run's PNG
+plots are :func:`gearbody.plotting.run.write_plots`.
 """
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from . import plots
-from .analysis import amplitude_spectrum, fold_over_mesh_period, separation_stats
-from .result import Result
+from gearbody.analysis import separation_stats
+from gearbody.result import Result
 
 FINAL_FRACTION = 0.25
 
@@ -89,61 +88,3 @@ def summarize(result: Result) -> dict[str, Any]:
             for axis in "xy"
         },
     }
-
-
-def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
-    """K_d over time, K_d folded over the mesh period (final window), spectrum of the acceleration."""
-    out = Path(out_dir)
-    title = result.meta.get("title", result.meta.get("scene", ""))
-    paths = [
-        plots.plot_kd_time(
-            result.time_s, result.kd, out / "kd_time.png", title=f"{title}: K_d = F(t)/F_rated"
-        )
-    ]
-    win = final_window(result)
-    f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
-    # at most one bin per sample of a mesh period, so that every bin is filled
-    bins = int(np.clip(result.sample_rate_hz / max(f_mesh, 1e-9), 10, 100))
-    folded = fold_over_mesh_period(
-        result.kd[win], pinion_angle(result)[win], int(result.meta["pinion_teeth"]), bins=bins
-    )
-    paths.append(
-        plots.plot_kd_folded(
-            folded,
-            out / "kd_folded.png",
-            title=f"{title}: K_d over the mesh period (last {FINAL_FRACTION:.0%} of run)",
-        )
-    )
-    name, signal = vibration_signal(result)
-    spec = amplitude_spectrum(signal[win], result.sample_rate_hz)
-    z1, z2 = int(result.meta["pinion_teeth"]), int(result.meta["wheel_teeth"])
-    shafts = {"f_1": f_mesh / z1, "f_2": f_mesh / z2} if f_mesh > 0 else {}
-    unit = "rad/s²" if name.endswith("rad_s2") else "m/s²"
-    paths.append(
-        plots.plot_spectrum(
-            spec,
-            out / "spectrum.png",
-            mesh_frequency_hz=f_mesh if f_mesh > 0 else None,
-            shaft_frequencies_hz=shafts,
-            title=f"{title}: spectrum of {name}",
-            fmax_hz=min(result.sample_rate_hz / 2, 8 * f_mesh if f_mesh > 0 else 1e9),
-            ylabel=f"amplitude [{unit}]",
-            log_amplitude=True,
-        )
-    )
-    gears = bearing_gears(result)
-    if gears:
-        paths.append(
-            plots.plot_signals(
-                result.time_s,
-                {
-                    f"{gear} {axis}": result[f"{gear}_bearing_force_{axis}_N"]
-                    for gear in gears
-                    for axis in "xy"
-                },
-                out / "bearing_forces.png",
-                title=f"{title}: forces on the housing at the bearings",
-                ylabel="bearing force [N]",
-            )
-        )
-    return paths

@@ -1,44 +1,24 @@
-"""PNG plots of K_d and spectra (as the paper's Figs. 6-8, 12 and 13-16).
+"""PNG plots of a run's signals: K_d over time, K_d folded over the mesh period, spectra and several
+signals of one unit (as the paper's Figs. 6-8, 12 and 13-16).
 
-Uses matplotlib's Agg canvas directly (no pyplot, no display, global backend untouched). Every function
-writes one PNG of exactly ``size_px`` pixels and returns its path. Engine-free: plain arrays in.
+Drawn with :func:`gearbody.plotting.figure.new_figure` (Agg canvas, no pyplot). Every function writes
+one PNG of exactly ``size_px`` pixels and returns its path. Engine-free: plain arrays in.
 """
 
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
 from gearbody.analysis.dynamic_factor import INSTABILITY_KD, FoldedSignal
 from gearbody.analysis.spectrum import Spectrum, mesh_harmonics
 
+from .figure import DEFAULT_SIZE_PX, PathLike, new_figure, save_figure
+
 __all__ = ["harmonic_labels", "plot_kd_folded", "plot_kd_time", "plot_signals", "plot_spectrum"]
-
-PathLike = str | os.PathLike[str]
-DEFAULT_SIZE_PX: tuple[int, int] = (1000, 600)
-
-
-def _figure(size_px: tuple[int, int], dpi: int) -> Figure:
-    width_px, height_px = size_px
-    if width_px < 1 or height_px < 1 or dpi < 1:
-        raise ValueError(f"size_px and dpi must be positive, got {size_px}, {dpi}")
-    fig = Figure(figsize=(width_px / dpi, height_px / dpi), dpi=dpi, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def _save(fig: Figure, path: PathLike, dpi: int) -> Path:
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=dpi, format="png")  # no bbox_inches="tight": keeps the requested pixel size
-    return out
-
 
 def _threshold_line(ax, kd_threshold: float | None) -> None:
     if kd_threshold is not None:
@@ -67,7 +47,7 @@ def plot_kd_time(
     dpi: int = 100,
 ) -> Path:
     """K_d [-] against time [s] (as Fig. 12); optional operating-period boundaries and K_d = 2 line."""
-    fig = _figure(size_px, dpi)
+    fig = new_figure(size_px, dpi)
     ax = fig.add_subplot()
     ax.plot(np.asarray(time_s, dtype=float), np.asarray(kd, dtype=float), linewidth=0.6, color="tab:blue")
     for t in boundaries_s:
@@ -80,7 +60,7 @@ def plot_kd_time(
     if kd_threshold is not None:
         ax.legend(loc="upper left")
     ax.grid(True, alpha=0.3)
-    return _save(fig, path, dpi)
+    return save_figure(fig, path, dpi)
 
 
 def plot_signals(
@@ -93,7 +73,7 @@ def plot_signals(
     dpi: int = 100,
 ) -> Path:
     """Several signals of one unit against time [s], one line each, labelled by their names."""
-    fig = _figure(size_px, dpi)
+    fig = new_figure(size_px, dpi)
     ax = fig.add_subplot()
     t = np.asarray(time_s, dtype=float)
     for name, values in signals.items():
@@ -105,7 +85,7 @@ def plot_signals(
     if signals:
         ax.legend(loc="upper left", fontsize="small")
     ax.grid(True, alpha=0.3)
-    return _save(fig, path, dpi)
+    return save_figure(fig, path, dpi)
 
 
 def plot_kd_folded(
@@ -118,7 +98,7 @@ def plot_kd_folded(
     dpi: int = 100,
 ) -> Path:
     """Mean K_d [-] over % of the mesh period (as Figs. 6-8), with the min-max band if ``show_range``."""
-    fig = _figure(size_px, dpi)
+    fig = new_figure(size_px, dpi)
     ax = fig.add_subplot()
     x = folded.percent_of_period
     if show_range:
@@ -134,7 +114,7 @@ def plot_kd_folded(
         ax.set_title(title)
     ax.legend(loc="upper right")
     ax.grid(True, alpha=0.3)
-    return _save(fig, path, dpi)
+    return save_figure(fig, path, dpi)
 
 
 def plot_spectrum(
@@ -163,7 +143,7 @@ def plot_spectrum(
     freq = spectrum.frequency_hz[shown]
     amp = spectrum.amplitude[shown]
 
-    fig = _figure(size_px, dpi)
+    fig = new_figure(size_px, dpi)
     ax = fig.add_subplot()
     if log_amplitude:
         peak = float(np.max(amp)) if amp.size and np.max(amp) > 0 else 1.0
@@ -205,4 +185,4 @@ def plot_spectrum(
     if title:
         ax.set_title(title, pad=14 if mesh_frequency_hz is not None else 6)
     ax.grid(True, alpha=0.3)
-    return _save(fig, path, dpi)
+    return save_figure(fig, path, dpi)

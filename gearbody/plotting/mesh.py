@@ -1,32 +1,32 @@
 """Figure of the mesh report (``gearbody mesh SCENE``): one PNG per gear stage with k_z over the mesh
 cycle (healthy), k_z around each damaged tooth and the static transmission error under load.
 
-Draws the data of :mod:`gearbody.mesh_report` on a matplotlib Agg canvas, as :mod:`gearbody.plots`
-(no pyplot; matplotlib is imported only when a figure is drawn). Engine-free. docs/mesh.md describes
-the figure.
+Draws the data of :mod:`gearbody.reports.mesh` with :func:`gearbody.plotting.figure.new_figure` (no
+pyplot; matplotlib is imported only when a figure is drawn). Engine-free. docs/mesh.md describes the
+figure.
 """
 
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
 
 import numpy as np
 
-from .mesh_report import (
+from gearbody.reports.mesh.curves import (
     DamageWindow,
     StaticTransmissionError,
     StiffnessCycle,
-    _load_label,
-    _stage_data,
-    _tooth_label,
-    stage_label,
+    load_label,
+    stage_data,
+    tooth_label,
 )
+from gearbody.reports.mesh.stage import stage_label
+
+from .figure import PathLike, new_figure, save_figure
 
 __all__ = ["plot_stage"]
 
-PathLike = str | os.PathLike[str]
 MAX_WINDOWS_PLOTTED = 4
 _PERIODS_LABEL = "Mesh periods u = phi_p z1 / 2 pi [-]"
 
@@ -94,7 +94,7 @@ def _plot_window(ax, w: DamageWindow) -> None:
     ax.plot(w.periods, _gn(w.stiffness_N_per_m), color="tab:red", linewidth=1.5, label="as given")
     ax.set_xlim(w.periods[0], w.periods[-1])
     ax.set_ylim(bottom=0)
-    title = f"{_tooth_label(w)}: {w.description} (min k_z / healthy = {w.min_ratio:.3f})"
+    title = f"{tooth_label(w)}: {w.description} (min k_z / healthy = {w.min_ratio:.3f})"
     _finish(ax, _PERIODS_LABEL, "k_z [1e9 N/m]", title, "lower right")
 
 
@@ -109,7 +109,7 @@ def _plot_te(ax, te: StaticTransmissionError) -> None:
     )
     ax.axhline(te.backlash_um, color="tab:green", linestyle=":", linewidth=1.0, label="l_u (backlash)")
     ax.set_xlim(0.0, te.periods[-1] + 0.5 * (te.periods[1] - te.periods[0]))
-    title = f"Static transmission error F/k - E + l_u at F = {te.force_N:.5g} N ({_load_label(te)})"
+    title = f"Static transmission error F/k - E + l_u at F = {te.force_N:.5g} N ({load_label(te)})"
     _finish(ax, _PERIODS_LABEL + " (pinion turn = z1 periods)", "Static TE [µm]", title, "upper right")
 
 
@@ -126,13 +126,11 @@ def plot_stage(
 ) -> Path:
     """One PNG of a stage: k_z over the mesh cycle (healthy), k_z around each damaged tooth (at most
     MAX_WINDOWS_PLOTTED panels), and the static transmission error over the pinion turn(s). The data
-    not passed in is computed with :mod:`gearbody.mesh_report`'s defaults."""
-    from .plots import _figure, _save
-
-    cycle, windows, te = _stage_data(scenario, stage, load_fraction, cycle, windows, te)
+    not passed in is computed with :mod:`gearbody.reports.mesh`'s defaults."""
+    cycle, windows, te = stage_data(scenario, stage, load_fraction, cycle, windows, te)
     shown = windows[:MAX_WINDOWS_PLOTTED]
     rows = 2 + len(shown)
-    fig = _figure((width_px, 330 * rows), dpi)
+    fig = new_figure((width_px, 330 * rows), dpi)
     axes = fig.subplots(rows, 1, squeeze=False)[:, 0]
     st = scenario.stages[stage]
     fig.suptitle(
@@ -146,4 +144,4 @@ def plot_stage(
     _plot_te(axes[-1], te)
     if len(windows) > len(shown):
         fig.text(0.01, 0.005, f"{len(windows) - len(shown)} more damaged teeth not shown", fontsize=8)
-    return _save(fig, path, dpi)
+    return save_figure(fig, path, dpi)

@@ -1,20 +1,19 @@
 """One self-contained HTML page per run: summary, labelled spectrum, folded K_d, TSA and indicators.
 
 Engine-free: works on any :class:`~gearbody.result.Result` (simulated, or loaded from result.npz).
-Figures are embedded as base64 PNG, so the page can be mailed or archived on its own.
+Figures (drawn by :mod:`gearbody.plotting.report`) are embedded as base64 PNG, so the page can be
+mailed or archived on its own.
 """
 
 from __future__ import annotations
 
-import base64
 import html
-import io
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .analysis import (
+from gearbody.analysis import (
     KinematicSources,
     amplitude_spectrum,
     condition_indicators_from_average,
@@ -24,23 +23,15 @@ from .analysis import (
     peaks_to_rows,
     synchronous_average,
 )
-from .analysis.labels import plot_labelled_spectrum
-from .plots import _figure
-from .result import Result
+from gearbody.plotting.figure import png_base64
+from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure, tsa_figure
+from gearbody.result import Result
+
 from .summary import FINAL_FRACTION, final_window, summarize, vibration_signal
 
 __all__ = ["report_sections", "write_report"]
 
 MIN_TSA_REVOLUTIONS = 2
-
-
-def _png(fig) -> str:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    FigureCanvasAgg(fig)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=100)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
 
 
 def _table(rows: list[dict[str, Any]], columns: list[str] | None = None) -> str:
@@ -87,26 +78,17 @@ def report_sections(result: Result) -> dict[str, Any]:
             spec, lines, tolerance_hz=1.5 * spec.resolution_hz, min_prominence_db=12.0, max_peaks=40,
             f_max_hz=f_max,
         )
-        fig = _figure((1100, 500), 100)
-        plot_labelled_spectrum(spec, peaks, ax=fig.add_subplot(1, 1, 1), title=f"spectrum of {name}",
-                               unit=unit, f_max_hz=f_max)
-        out["figures"]["spectrum"] = _png(fig)
+        fig = labelled_spectrum_figure(spec, peaks, title=f"spectrum of {name}", unit=unit, f_max_hz=f_max)
+        out["figures"]["spectrum"] = png_base64(fig)
     out["peaks"] = peaks_to_rows(peaks)
 
     # K_d folded over the mesh period
     if f_mesh > 0:
         bins = int(np.clip(result.sample_rate_hz / f_mesh, 10, 100))
         folded = fold_over_mesh_period(result.kd[win], result["pinion_angle_rad"][win], z1, bins=bins)
-        fig = _figure((900, 400), 100)
-        ax = fig.add_subplot(1, 1, 1)
-        ax.fill_between(folded.percent_of_period, folded.minimum, folded.maximum, alpha=0.3, label="min-max")
-        ax.plot(folded.percent_of_period, folded.mean, label="mean")
-        ax.axhline(2.0, color="red", ls=":", lw=0.8)
-        ax.set_xlabel("mesh period [%]")
-        ax.set_ylabel("K_d")
-        ax.legend()
-        ax.set_title(f"K_d over the mesh period (last {FINAL_FRACTION:.0%} of the run)")
-        out["figures"]["kd_folded"] = _png(fig)
+        title = f"K_d over the mesh period (last {FINAL_FRACTION:.0%} of the run)"
+        fig = kd_folded_figure(folded, title=title)
+        out["figures"]["kd_folded"] = png_base64(fig)
 
     # synchronous average over pinion revolutions, and condition indicators
     angle = result["pinion_angle_rad"][win]
@@ -116,18 +98,8 @@ def report_sections(result: Result) -> dict[str, Any]:
         tsa = synchronous_average(signal[win], angle, teeth=z1)
         out["indicators"] = condition_indicators_from_average(tsa).as_dict()
         out["tsa_revolutions"] = tsa.n_revs
-        fig = _figure((1100, 500), 100)
-        ax = fig.add_subplot(2, 1, 1)
-        deg = np.degrees(tsa.angle_rad)
-        ax.plot(deg, tsa.average, lw=0.7)
-        ax.set_title(f"TSA of {name} over {tsa.n_revs} pinion revolutions", fontsize=9)
-        ax = fig.add_subplot(2, 1, 2)
-        ax.plot(deg, tsa.difference(), lw=0.7, color="C3")
-        ax.set_title(
-            "difference signal (mesh harmonics, first sidebands, shaft orders 1-2 removed)", fontsize=9
-        )
-        ax.set_xlabel("pinion angle [deg]")
-        out["figures"]["tsa"] = _png(fig)
+        fig = tsa_figure(tsa, name)
+        out["figures"]["tsa"] = png_base64(fig)
     else:
         out["tsa_note"] = (
             f"no TSA: the final window holds {revs:.1f} pinion revolutions "

@@ -1,0 +1,42 @@
+"""``gearbody modes SCENE``: natural frequencies at mean mesh stiffness, their dominant motion, and the
+pinion speeds where mesh harmonics meet them (:mod:`gearbody.analysis.modal`)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from .common import EXIT_OK, add_set, load
+
+
+def register(sub) -> argparse.ArgumentParser:
+    """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    modes = sub.add_parser(
+        "modes", help="natural frequencies (Hz) at mean mesh stiffness, and resonance speeds"
+    )
+    modes.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
+    add_set(modes, "override a scenario value (as for run)")
+    modes.add_argument("--harmonics", type=int, default=3, help="mesh harmonics to list resonance speeds for")
+    modes.set_defaults(handler=execute)
+    return modes
+
+
+def execute(args) -> int:
+    from gearbody.analysis.modal import resonance_speeds_rad_s
+    from gearbody.engine import scene_modes
+
+    scenario = load(args.scene, args.overrides)
+    modes = scene_modes(scenario)
+    z1 = scenario.stages[0].pinion.teeth
+    k = ", ".join(f"{x:.4g}" for x in modes.mean_mesh_stiffness_N_per_m)
+    print(f"{scenario.meta.title}")
+    print(f"linearised at mean mesh stiffness {k} N/m; DOFs: {', '.join(modes.dof_names)}")
+    speeds = resonance_speeds_rad_s(modes, z1, args.harmonics)
+    head = "".join(f"{f'w({h}f_z) rad/s':>18}" for h in range(1, args.harmonics + 1))
+    width = max(len(modes.label(m)) for m in range(len(modes.frequencies_hz))) + 2
+    print(f"{'mode':>4} {'f_n Hz':>12}  {'dominant motion (share of kinetic energy)':<{width}}{head}")
+    for m, f in enumerate(modes.frequencies_hz):
+        cols = "".join(f"{'-' if math.isnan(s) else f'{s:.2f}':>18}" for s in speeds[:, m])
+        print(f"{m + 1:>4} {f:12.3f}  {modes.label(m):<{width}}{cols}")
+    print(f"(w(k f_z) = pinion speed at which the k-th mesh harmonic z1 w k / 2 pi meets f_n; z1 = {z1})")
+    return EXIT_OK

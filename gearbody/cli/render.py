@@ -1,0 +1,181 @@
+"""``gearbody render SCENE``: 3D frames and an animated GIF/MP4 of the drive moving as simulated
+(:mod:`gearbody.render`)."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from .common import EXIT_OK, add_out, add_set, default_out, load, scenario_overrides, usage_error
+
+
+def register(sub) -> argparse.ArgumentParser:
+    """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    rd = sub.add_parser(
+        "render",
+        help="3D pictures and an animated GIF/MP4 of the drive moving as simulated (no display needed)",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description=(
+            "Lay SCENE out in 3D from its own numbers (teeth, base radii, face widths, centre distances) "
+            "and render N frames of it moving as in a result: DIR/frame_0000.png ... and "
+            "DIR/animation.gif (or .mp4 with --format mp4 where ffmpeg is installed), with Exudyn's "
+            "software raytracer: no display needed. Without --result, SCENE is simulated first "
+            "and its result.npz and scenario.toml are kept in DIR (--kinematic: rigid rotation, no "
+            "simulation). Lateral gear motion is magnified by "
+            "--lateral-scale. --interactive replays in Exudyn's viewer instead (needs a display). "
+            "See docs/render.md."
+        ),
+    )
+    rd.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
+    rd.add_argument("--result", type=Path, metavar="DIR", help="a 'gearbody run' folder (or its result.npz)")
+    rd.add_argument(
+        "--kinematic", action="store_true", help="no simulation: rigid rotation at synchronous speed"
+    )
+    add_set(rd, "override a scenario value (as for run)")
+    rd.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time when simulating first")
+    rd.add_argument(
+        "--frames", type=int, metavar="N", help="number of frames (default 24; --interactive: 400)"
+    )
+    rd.add_argument(
+        "--start",
+        type=float,
+        metavar="SECONDS",
+        help="time of the first frame (default: one input-shaft revolution before --end)",
+    )
+    rd.add_argument(
+        "--end", type=float, metavar="SECONDS", help="time of the last frame (default: end of result)"
+    )
+    add_out(rd, "output folder (default: runs/SCENE/render)")
+    rd.add_argument(
+        "--format", choices=("gif", "mp4", "none"), default="gif", help="movie format (default gif)"
+    )
+    rd.add_argument("--fps", type=float, default=20.0, help="movie frames per second (default 20)")
+    rd.add_argument("--width", type=int, default=800, help="image width in pixels (default 800)")
+    rd.add_argument("--height", type=int, default=600, help="image height in pixels (default 600)")
+    rd.add_argument("--view", default="iso", help="camera preset: iso, front, back, side, top (default iso)")
+    rd.add_argument(
+        "--azimuth", type=float, metavar="DEG", help="camera azimuth about the vertical, overrides --view"
+    )
+    rd.add_argument("--elevation", type=float, metavar="DEG", help="camera elevation, overrides --view")
+    rd.add_argument("--zoom", type=float, default=1.0, help="magnification (1 = whole drive or all gears)")
+    rd.add_argument(
+        "--frame",
+        choices=("drive", "gears"),
+        default="drive",
+        help="what the camera fits: the whole drive or the gears (hides motor and machine)",
+    )
+    rd.add_argument(
+        "--housing",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="draw the transparent housing (default: the scenario's visual.housing)",
+    )
+    rd.add_argument(
+        "--lateral-scale",
+        type=float,
+        metavar="X",
+        help="magnification of lateral gear motion (default: the scenario's visual.lateral_scale)",
+    )
+    rd.add_argument(
+        "--lateral-static",
+        action="store_true",
+        help="magnify the whole lateral displacement, static deflection included "
+        "(default: the motion about its mean over the frames)",
+    )
+    rd.add_argument("--background", default="1,1,1", metavar="R,G,B", help="background colour, 0-1 each")
+    rd.add_argument("--interactive", action="store_true", help="replay in Exudyn's viewer (needs a display)")
+    rd.add_argument("--quiet", action="store_true", help="no progress display")
+    rd.set_defaults(handler=execute)
+    return rd
+
+
+def execute(args) -> int:
+    from gearbody.render import RenderError, RenderOptions, render, view
+    from gearbody.result import Result
+
+    overrides = scenario_overrides(args)
+    scenario = load(args.scene, overrides)
+    try:
+        background = tuple(float(v) for v in args.background.split(","))
+        if len(background) != 3:
+            raise ValueError
+    except ValueError:
+        return usage_error("render", f"--background = {args.background!r}: give R,G,B in [0, 1]")
+    options = RenderOptions(
+        width_px=args.width,
+        height_px=args.height,
+        view=args.view,
+        azimuth_deg=args.azimuth,
+        elevation_deg=args.elevation,
+        zoom=args.zoom,
+        frame=args.frame,
+        housing=args.housing,
+        background=background,
+    )
+    try:
+        options.check()
+        if args.t_end is not None and (args.result is not None or args.kinematic):
+            raise RenderError(
+                "--t-end applies only when SCENE is simulated first (not with --result or --kinematic)"
+            )
+        if args.result is not None:
+            path = args.result / "result.npz" if args.result.is_dir() else args.result
+            if not path.is_file():
+                raise RenderError(
+                    f"--result = {args.result}: no result.npz there (write one with 'gearbody run')"
+                )
+            result = Result.load_npz(path)
+        elif args.kinematic:
+            result = None
+        else:
+            from gearbody.engine import simulate
+
+            if not args.quiet:
+                print(f"simulating {args.scene} ({scenario.operation.t_end_s:g} s) ...")
+            result = simulate(scenario, progress=not args.quiet)
+        out_dir = args.out or default_out(args.scene, "render")
+        if args.result is None and not args.kinematic and not args.interactive:
+            from gearbody.model import dump_scenario
+
+            out_dir.mkdir(parents=True, exist_ok=True)  # keep what was simulated: re-render with --result
+            result.save_npz(out_dir / "result.npz")
+            dump_scenario(scenario, out_dir / "scenario.toml")
+        if args.interactive:
+            view(
+                scenario,
+                result,
+                frames=400 if args.frames is None else max(args.frames, 2),
+                start_s=args.start,
+                end_s=args.end,
+                options=options,
+                lateral_scale=args.lateral_scale,
+                lateral_about_mean=not args.lateral_static,
+                fps=args.fps,
+            )
+            return EXIT_OK
+        t0 = time.perf_counter()
+        out = render(
+            scenario,
+            result,
+            out_dir=out_dir,
+            frames=24 if args.frames is None else args.frames,
+            start_s=args.start,
+            end_s=args.end,
+            options=options,
+            lateral_scale=args.lateral_scale,
+            lateral_about_mean=not args.lateral_static,
+            movie=args.format,
+            fps=args.fps,
+            progress=not args.quiet,
+        )
+    except RenderError as exc:
+        return usage_error("render", str(exc))
+    if not args.quiet:
+        per = out.render_s / max(len(out.frames), 1)
+        print(
+            f"wrote {len(out.frames)} frames ({args.width}x{args.height}) to {out_dir}"
+            + (f" and {out.movie.name}" if out.movie else "")
+            + f" in {time.perf_counter() - t0:.1f} s ({per:.2f} s per frame, scene build {out.build_s:.1f} s)"
+        )
+    return EXIT_OK

@@ -1,0 +1,26 @@
+"""``gearbody validate``: compare gearbody with the independent ODE reference (exit 1 above tolerance)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import EXIT_FAILED, EXIT_OK
+
+
+def register(sub) -> argparse.ArgumentParser:
+    """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    val = sub.add_parser(
+        "validate", help="compare gearbody with the independent ODE reference (exit 1 above tolerance)"
+    )
+    val.add_argument("scenes", metavar="SCENE", nargs="*", help="scenes to validate (default: all)")
+    val.add_argument("--short", action="store_true", help="short runs (as in the test suite)")
+    val.add_argument("--tolerance", type=float, default=0.5, help="max |dF|/F_rated in %% (default 0.5)")
+    val.set_defaults(handler=execute)
+    return val
+
+
+def execute(args) -> int:
+    from gearbody_validation.compare import run_validation
+
+    ok = run_validation(args.scenes or None, short=args.short, tolerance_percent=args.tolerance)
+    return EXIT_OK if ok else EXIT_FAILED

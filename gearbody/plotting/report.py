@@ -1,0 +1,58 @@
+"""The figures of the HTML run report (:mod:`gearbody.reports.html`): the labelled spectrum, K_d folded
+over the mesh period, and the synchronous average with its difference signal. Each returns a Figure
+for :func:`gearbody.plotting.figure.png_base64`."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from gearbody.analysis.labels import plot_labelled_spectrum
+
+from .figure import new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from gearbody.analysis import FoldedSignal, LabelledPeak, Spectrum, SynchronousAverage
+
+__all__ = ["kd_folded_figure", "labelled_spectrum_figure", "tsa_figure"]
+
+
+def labelled_spectrum_figure(
+    spec: Spectrum, peaks: list[LabelledPeak], title: str, unit: str, f_max_hz: float
+) -> Figure:
+    """The spectrum with its labelled peaks (:func:`gearbody.analysis.labels.plot_labelled_spectrum`)."""
+    fig = new_figure((1100, 500), 100)
+    ax = fig.add_subplot(1, 1, 1)
+    plot_labelled_spectrum(spec, peaks, ax=ax, title=title, unit=unit, f_max_hz=f_max_hz)
+    return fig
+
+
+def kd_folded_figure(folded: FoldedSignal, title: str) -> Figure:
+    """Mean K_d with its min-max band over the mesh period, and the K_d = 2 line."""
+    fig = new_figure((900, 400), 100)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.fill_between(folded.percent_of_period, folded.minimum, folded.maximum, alpha=0.3, label="min-max")
+    ax.plot(folded.percent_of_period, folded.mean, label="mean")
+    ax.axhline(2.0, color="red", ls=":", lw=0.8)
+    ax.set_xlabel("mesh period [%]")
+    ax.set_ylabel("K_d")
+    ax.legend()
+    ax.set_title(title)
+    return fig
+
+
+def tsa_figure(tsa: SynchronousAverage, name: str) -> Figure:
+    """The synchronous average of signal ``name`` over pinion revolutions, and its difference signal."""
+    fig = new_figure((1100, 500), 100)
+    ax = fig.add_subplot(2, 1, 1)
+    deg = np.degrees(tsa.angle_rad)
+    ax.plot(deg, tsa.average, lw=0.7)
+    ax.set_title(f"TSA of {name} over {tsa.n_revs} pinion revolutions", fontsize=9)
+    ax = fig.add_subplot(2, 1, 2)
+    ax.plot(deg, tsa.difference(), lw=0.7, color="C3")
+    ax.set_title("difference signal (mesh harmonics, first sidebands, shaft orders 1-2 removed)", fontsize=9)
+    ax.set_xlabel("pinion angle [deg]")
+    return fig

@@ -1,0 +1,80 @@
+"""The standard PNG plots of a run (``gearbody run``): K_d over time, K_d folded over the mesh period,
+the spectrum of the vibration signal and, for lateral gears, the bearing forces."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from gearbody.analysis import amplitude_spectrum, fold_over_mesh_period
+from gearbody.reports.summary import (
+    FINAL_FRACTION,
+    bearing_gears,
+    final_window,
+    pinion_angle,
+    vibration_signal,
+)
+from gearbody.result import Result
+
+from .result import plot_kd_folded, plot_kd_time, plot_signals, plot_spectrum
+
+__all__ = ["write_plots"]
+
+
+def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
+    """K_d over time, K_d folded over the mesh period (final window), spectrum of the acceleration."""
+    out = Path(out_dir)
+    title = result.meta.get("title", result.meta.get("scene", ""))
+    paths = [
+        plot_kd_time(
+            result.time_s, result.kd, out / "kd_time.png", title=f"{title}: K_d = F(t)/F_rated"
+        )
+    ]
+    win = final_window(result)
+    f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
+    # at most one bin per sample of a mesh period, so that every bin is filled
+    bins = int(np.clip(result.sample_rate_hz / max(f_mesh, 1e-9), 10, 100))
+    folded = fold_over_mesh_period(
+        result.kd[win], pinion_angle(result)[win], int(result.meta["pinion_teeth"]), bins=bins
+    )
+    paths.append(
+        plot_kd_folded(
+            folded,
+            out / "kd_folded.png",
+            title=f"{title}: K_d over the mesh period (last {FINAL_FRACTION:.0%} of run)",
+        )
+    )
+    name, signal = vibration_signal(result)
+    spec = amplitude_spectrum(signal[win], result.sample_rate_hz)
+    z1, z2 = int(result.meta["pinion_teeth"]), int(result.meta["wheel_teeth"])
+    shafts = {"f_1": f_mesh / z1, "f_2": f_mesh / z2} if f_mesh > 0 else {}
+    unit = "rad/s²" if name.endswith("rad_s2") else "m/s²"
+    paths.append(
+        plot_spectrum(
+            spec,
+            out / "spectrum.png",
+            mesh_frequency_hz=f_mesh if f_mesh > 0 else None,
+            shaft_frequencies_hz=shafts,
+            title=f"{title}: spectrum of {name}",
+            fmax_hz=min(result.sample_rate_hz / 2, 8 * f_mesh if f_mesh > 0 else 1e9),
+            ylabel=f"amplitude [{unit}]",
+            log_amplitude=True,
+        )
+    )
+    gears = bearing_gears(result)
+    if gears:
+        paths.append(
+            plot_signals(
+                result.time_s,
+                {
+                    f"{gear} {axis}": result[f"{gear}_bearing_force_{axis}_N"]
+                    for gear in gears
+                    for axis in "xy"
+                },
+                out / "bearing_forces.png",
+                title=f"{title}: forces on the housing at the bearings",
+                ylabel="bearing force [N]",
+            )
+        )
+    return paths

@@ -1,0 +1,142 @@
+"""Running a parameter study (``gearbody sweep``): check the whole spec and every case before anything
+runs, resume what the output folder already holds, run the pending cases on an executor (serial,
+process pool or Dask), write each finished case at once, then ``OUT/summary.csv`` and the plot.
+
+The package docstring (:mod:`gearbody.studies`) describes the study; docs/sweep.md the files.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from gearbody.plotting.study import plot_study
+
+from .executors import check_options, run_jobs
+from .parse import SweepSpecError
+from .spec import Study
+from .store import case_state, prepare_out, write_case
+from .table import DEFAULT_PLOT_VALUE, StudyResult, check_plot_value, collect_rows, write_csv
+from .tasks import run_case
+
+__all__ = ["run_study"]
+
+
+def run_study(
+    scene: str | Path | Study,
+    *,
+    out_dir: str | Path,
+    vary: Mapping[str, Sequence[Any] | str] | Sequence[str] | None = None,
+    random: Mapping[str, str] | Sequence[str] | None = None,
+    samples: int | None = None,
+    study_seed: int = 0,
+    seeds: int | None = None,
+    base_overrides: Sequence[str] = (),
+    workers: int | None = None,
+    scheduler: str | Any | None = None,
+    progress: bool = True,
+    save_results: bool = True,
+    retry_failed: bool = False,
+    plot_value: str = DEFAULT_PLOT_VALUE,
+    plot_key: str | None = None,
+) -> StudyResult:
+    """Run a parameter study, resuming whatever ``out_dir`` already holds of it.
+
+    Args:
+        scene: scene name, TOML path, or a prepared :class:`Study` (then leave the spec arguments out).
+        out_dir: output folder (``study.json``, ``cases/<id>/``, ``summary.csv``, the plot).
+        vary, random, samples, study_seed, seeds, base_overrides: the study, see :meth:`Study.build`.
+        workers: local processes (default ``os.cpu_count()``); 1 runs the cases in this process.
+        scheduler: a Dask scheduler address (``tcp://host:8786``) or a ``dask.distributed.Client``;
+            the cases then run on that cluster (``workers`` must be left out).
+        progress: show a progress bar (done, failed, time left) on stderr.
+        save_results: write each case's ``result.npz`` (off for big studies: summaries only).
+        retry_failed: rerun cases that have an ``error.json``.
+        plot_value: summary value to plot (default ``kd_max_final``).
+        plot_key: varied key on the x axis (default: the first one).
+    Raises:
+        SweepSpecError, ScenarioError: bad input, before anything runs.
+        ImportError: ``scheduler`` given but dask.distributed is not installed.
+    """
+    if isinstance(scene, Study):
+        if vary or random or samples is not None or seeds is not None or base_overrides or study_seed:
+            raise SweepSpecError("give either a Study or the spec arguments (vary, random, ...), not both")
+        study = scene
+    else:
+        study = Study.build(
+            scene,
+            vary=vary,
+            random=random,
+            samples=samples,
+            study_seed=study_seed,
+            seeds=seeds,
+            base_overrides=base_overrides,
+        )
+    keys = study.keys
+    plot_key = plot_key or keys[0]
+    if plot_key not in keys:
+        raise SweepSpecError(f"--plot-key {plot_key}: not a varied key; one of {', '.join(keys)}")
+    check_plot_value(plot_value)
+    check_options(workers, scheduler)
+
+    cases = study.cases()
+    scenarios = {c.id: study.load_case(c) for c in cases}  # every case valid before anything runs
+    out = Path(out_dir)
+    prepare_out(out, study, cases)
+
+    pending = []
+    for case in cases:
+        state, _ = case_state(out / "cases" / case.id)
+        if state == "pending" or (state == "failed" and retry_failed):
+            pending.append(case)
+    skipped = len(cases) - len(pending)
+    if progress and skipped:
+        print(f"resuming {out}: {skipped} of {len(cases)} cases already done", file=sys.stderr)
+
+    by_id = {c.id: c for c in pending}
+    jobs = [(c.id, (study.base, c.overrides, save_results)) for c in pending]
+    runner = run_jobs(run_case, jobs, workers=workers, scheduler=scheduler)  # run_case looked up now
+
+    from tqdm import tqdm
+
+    failed = 0
+    bar = None
+    try:
+        for cid, outcome in runner:
+            if bar is None:  # created after the pool has started its processes
+                bar = tqdm(
+                    total=len(jobs),
+                    desc="sweep",
+                    unit="case",
+                    disable=not progress,
+                    file=sys.stderr,
+                    bar_format="{desc}: {n_fmt}/{total_fmt} cases done{postfix} |{bar}| "
+                    "[{elapsed}<{remaining}]",
+                )
+                bar.set_postfix_str("0 failed", refresh=False)
+            write_case(out / "cases" / cid, by_id[cid], scenarios[cid], outcome, save_results)
+            failed += not outcome["ok"]
+            bar.set_postfix_str(f"{failed} failed", refresh=False)
+            bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+        close = getattr(runner, "close", None)
+        if close:
+            close()
+
+    rows, summary_cols = collect_rows(out, cases, keys)
+    columns = ["id", *keys, "status", *summary_cols, "error"]
+    csv_path = write_csv(out / "summary.csv", rows, columns)
+    plot_path = plot_study(
+        rows,
+        keys,
+        plot_value,
+        plot_key,
+        out / f"{plot_value}_vs_{plot_key}.png",
+        title=f"{study.scene if len(study.scene) < 40 else Path(study.scene).name}: {plot_value} "
+        f"against {plot_key}",
+    )
+    return StudyResult(out, keys, rows, len(jobs), skipped, csv_path, plot_path, plot_value)

@@ -1,0 +1,252 @@
+"""What a parameter study runs: :class:`Study` (a scene, fixed overrides, the varied keys) and its
+:class:`Case` list, the product grid x random samples x seeds with stable ids and deterministic
+overrides. Every case is validated (its scenario loaded) before anything runs."""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from gearbody.model import Scenario, ScenarioError, parse_override
+from gearbody.model.io import load_scenario, read_toml
+
+from .parse import (
+    Axis,
+    RandomAxis,
+    SweepSpecError,
+    check_key,
+    parse_random,
+    parse_vary,
+    toml_literal,
+    toml_value,
+)
+
+__all__ = ["SEED_KEY", "Case", "Study"]
+
+SEED_KEY = "meta.seed"
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run of a study."""
+
+    id: str
+    overrides: tuple[str, ...]
+    """All overrides of this case: the study's fixed ones, then one per varied key."""
+    texts: dict[str, str]
+    """Varied key -> TOML literal of its value in this case."""
+    values: dict[str, Any]
+    """Varied key -> value."""
+
+
+def _resolve_scene(scene: str | Path) -> tuple[str, Path]:
+    """(label stored in the spec, TOML path), as :func:`gearbody.model.load_scenario` resolves it."""
+    from gearbody.model.scenes import scene_path
+
+    path = Path(scene)
+    if not path.suffix and not path.exists():
+        return str(scene), scene_path(str(scene))
+    if not path.is_file():
+        raise ScenarioError(f"{path}: no such scenario file")
+    return str(path.resolve()), path
+
+
+@dataclass(frozen=True)
+class Study:
+    """What a parameter study runs; build it with :meth:`Study.build`."""
+
+    scene: str
+    """Scene name, or the absolute path of a TOML scenario."""
+    base: dict[str, Any] = field(repr=False, compare=False)
+    """The scene's TOML data, shipped to the workers (they need neither the file nor the scene)."""
+    scene_sha256: str
+    base_overrides: tuple[str, ...] = ()
+    vary: tuple[Axis, ...] = ()
+    random: tuple[RandomAxis, ...] = ()
+    samples: int = 0
+    study_seed: int = 0
+    seeds: int = 0
+
+    @classmethod
+    def build(
+        cls,
+        scene: str | Path,
+        *,
+        vary: Mapping[str, Sequence[Any] | str] | Sequence[str] | None = None,
+        random: Mapping[str, str] | Sequence[str] | None = None,
+        samples: int | None = None,
+        study_seed: int = 0,
+        seeds: int | None = None,
+        base_overrides: Sequence[str] = (),
+    ) -> Study:
+        """Check and assemble a study.
+
+        Args:
+            scene: scene name or path of a TOML scenario.
+            vary: grid keys: ``["KEY=0:20:5", "KEY2=a,b"]`` (command-line form) or a mapping
+                ``{KEY: "0:20:5" | "a,b" | [python values]}``.
+            random: Monte-Carlo keys: ``["KEY=uniform(a,b)"]`` or ``{KEY: "normal(mu,sigma)"}``.
+            samples: number of random draws (required with ``random``).
+            study_seed: seed of the random draws.
+            seeds: vary ``meta.seed`` over 1..seeds.
+            base_overrides: fixed ``KEY=VALUE`` overrides of every case (``--set``).
+        Raises:
+            SweepSpecError: bad syntax or conflicting options (the message names the argument).
+            ScenarioError: unknown scene or bad scenario file.
+        """
+        axes = _vary_axes(vary)
+        rand = _random_axes(random)
+        if rand and samples is None:
+            raise SweepSpecError(f"{rand[0].label}: give the number of draws with --samples N")
+        if samples is not None and (isinstance(samples, bool) or int(samples) != samples or samples < 1):
+            raise SweepSpecError(f"--samples must be a whole number >= 1, got {samples!r}")
+        if samples is not None and not rand:
+            raise SweepSpecError("--samples needs at least one --random KEY=DIST")
+        if seeds is not None and (isinstance(seeds, bool) or int(seeds) != seeds or seeds < 1):
+            raise SweepSpecError(f"--seeds must be a whole number >= 1, got {seeds!r}")
+        if isinstance(study_seed, bool) or int(study_seed) != study_seed or study_seed < 0:
+            raise SweepSpecError(f"--study-seed must be a whole number >= 0, got {study_seed!r}")
+        if not axes and not rand and not seeds:
+            raise SweepSpecError(
+                "nothing to vary: give at least one of --vary, --random (with --samples), --seeds"
+            )
+        seen: dict[str, str] = {}
+        for a in (*axes, *rand):
+            if a.key in seen:
+                raise SweepSpecError(f"{a.label}: {a.key} is already varied by {seen[a.key]}")
+            seen[a.key] = a.label
+        if seeds and SEED_KEY in seen:
+            raise SweepSpecError(f"{seen[SEED_KEY]}: {SEED_KEY} is already varied by --seeds")
+        base_overrides = tuple(base_overrides)
+        for o in base_overrides:
+            key = parse_override(o)[0]  # ScenarioError naming --set on bad syntax
+            if key in seen or (seeds and key == SEED_KEY):
+                by = seen.get(key, "--seeds")
+                raise SweepSpecError(f"--set {o}: {key} is also varied by {by}; give it in one place")
+        label, path = _resolve_scene(scene)
+        base = read_toml(path)
+        if isinstance(base.get("meta"), dict):  # the cases of a study carry the scene's name
+            base["meta"].setdefault("name", path.stem)
+        return cls(
+            scene=label,
+            base=base,
+            scene_sha256=hashlib.sha256(path.read_bytes()).hexdigest(),
+            base_overrides=base_overrides,
+            vary=axes,
+            random=rand,
+            samples=int(samples or 0),
+            study_seed=int(study_seed),
+            seeds=int(seeds or 0),
+        )
+
+    def axes(self) -> list[Axis]:
+        """Every varied key with its values: grid keys, random keys (drawn), then ``meta.seed``."""
+        out = list(self.vary) + [r.axis(self.samples, self.study_seed) for r in self.random]
+        if self.seeds:
+            texts = tuple(str(s) for s in range(1, self.seeds + 1))
+            out.append(Axis(SEED_KEY, texts, tuple(range(1, self.seeds + 1)), "--seeds"))
+        return out
+
+    @property
+    def keys(self) -> list[str]:
+        """The varied keys, in column order."""
+        return [a.key for a in self.axes()]
+
+    def cases(self) -> list[Case]:
+        """All cases: grid (first key outermost) x random samples x seeds, with stable ids."""
+        axes = self.axes()
+        grid = list(self.vary)
+        rand = axes[len(grid) : len(grid) + len(self.random)]
+        seed_axes = axes[len(grid) + len(self.random) :]
+        grid_idx = itertools.product(*(range(len(a.texts)) for a in grid))
+        sample_idx = range(self.samples) if rand else [None]
+        seed_idx = range(self.seeds) if seed_axes else [None]
+        combos = list(itertools.product(grid_idx, sample_idx, seed_idx))
+        width = max(4, len(str(len(combos) - 1)))
+        cases = []
+        for n, (g, s, k) in enumerate(combos):
+            picks = [(a, i) for a, i in zip(grid, g, strict=True)]
+            picks += [(a, s) for a in rand] + [(a, k) for a in seed_axes]
+            texts = {a.key: a.texts[i] for a, i in picks}
+            values = {a.key: a.values[i] for a, i in picks}
+            overrides = self.base_overrides + tuple(f"{key}={t}" for key, t in texts.items())
+            cases.append(Case(f"case-{n:0{width}d}", overrides, texts, values))
+        return cases
+
+    def spec(self) -> dict[str, Any]:
+        """The defining part of the study (stored in study.json; a resume must match it)."""
+        return {
+            "scene": self.scene,
+            "scene_sha256": self.scene_sha256,
+            "base_overrides": list(self.base_overrides),
+            "vary": {a.key: list(a.texts) for a in self.vary},
+            "random": {r.key: str(r.distribution) for r in self.random},
+            "samples": self.samples,
+            "study_seed": self.study_seed,
+            "seeds": self.seeds,
+        }
+
+    def load_case(self, case: Case) -> Scenario:
+        """The case's validated scenario; a ScenarioError names the case and the argument at fault (the
+        first whose override alone, on top of the fixed ones, is refused)."""
+        try:
+            return load_scenario(self.base, list(case.overrides))
+        except ScenarioError as exc:
+            fixed = list(self.base_overrides)
+            where = ""
+            if not _loads(self.base, fixed):
+                where = "--set: "
+            else:
+                labels = {a.key: a.label for a in self.axes()}
+                for key, text in case.texts.items():
+                    if not _loads(self.base, [*fixed, f"{key}={text}"]):
+                        where = f"{labels[key]}: "
+                        break
+            values = ", ".join(f"{k}={t}" for k, t in case.texts.items())
+            raise ScenarioError(f"{where}{case.id} ({values}): {exc}") from None
+
+
+def _loads(base: dict[str, Any], overrides: list[str]) -> bool:
+    try:
+        load_scenario(base, overrides)
+    except ScenarioError:
+        return False
+    return True
+
+
+def _vary_axes(vary: Mapping[str, Sequence[Any] | str] | Sequence[str] | None) -> tuple[Axis, ...]:
+    if not vary:
+        return ()
+    if isinstance(vary, str):
+        vary = [vary]
+    if not isinstance(vary, Mapping):
+        return tuple(parse_vary(t) for t in vary)
+    axes = []
+    for key, spec in vary.items():
+        label = f"vary[{key!r}]"
+        if isinstance(spec, str):
+            axes.append(parse_vary(f"{key}={spec}", label=label))
+            continue
+        check_key(key, label)
+        values = list(spec)
+        if not values:
+            raise SweepSpecError(f"{label}: no values")
+        texts = tuple(toml_literal(v) for v in values)
+        if len(set(texts)) != len(texts):
+            raise SweepSpecError(f"{label}: repeated value in {values!r}")
+        axes.append(Axis(key, texts, tuple(toml_value(t) for t in texts), label))
+    return tuple(axes)
+
+
+def _random_axes(random: Mapping[str, str] | Sequence[str] | None) -> tuple[RandomAxis, ...]:
+    if not random:
+        return ()
+    if isinstance(random, str):
+        random = [random]
+    if isinstance(random, Mapping):
+        return tuple(parse_random(f"{k}={v}", label=f"random[{k!r}]") for k, v in random.items())
+    return tuple(parse_random(t) for t in random)
