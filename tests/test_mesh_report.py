@@ -150,7 +150,7 @@ def test_cli_hand_given_scene_and_train(tmp_path, capsys):
     out = tmp_path / "two"
     assert main(["mesh", "two-stage", "--out", str(out)]) == 0
     text = capsys.readouterr().out
-    assert "stage 1 of 2 (design.stages[0])" in text and "stage 2 of 2 (design.stages[1])" in text
+    assert "stage 1 of 2 (design.stages.1)" in text and "stage 2 of 2 (design.stages.2)" in text
     assert sorted(p.name for p in out.iterdir()) == ["mesh_stage1.png", "mesh_stage2.png"]
     only = tmp_path / "only"
     assert main(["mesh", "two-stage", "--stage", "2", "--out", str(only)]) == 0
