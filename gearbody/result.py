@@ -8,11 +8,15 @@ so a saved result says where it came from.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+FINAL_FRACTION = 0.25
+"""Share of the run, at its end, over which 'final' values are taken (the steady period)."""
 
 
 @dataclass
@@ -84,7 +88,9 @@ class Result:
                 return self[f"{gear}_{stage + 1}_{name[len(gear) + 1 :]}"]
         return self[f"stage_{stage + 1}_{name}"]
 
-    def final_window(self, fraction: float = 0.25) -> np.ndarray:
+    FINAL_FRACTION = FINAL_FRACTION
+
+    def final_window(self, fraction: float = FINAL_FRACTION) -> np.ndarray:
         """Boolean mask of the last ``fraction`` of the simulated time (the steady period of a run)."""
         if not 0 < fraction <= 1:
             raise ValueError(f"fraction = {fraction}: must be > 0 and <= 1")
@@ -145,6 +151,68 @@ class Result:
             if name in self and f"{name.split('_housing')[0]}_y_m" in self:
                 return name
         return "pinion_accel_rad_s2" if "pinion_accel_rad_s2" in self else "deflection_accel_m_s2"
+
+    @property
+    def bearing_gears(self) -> list[str]:
+        """Names of the gears with bearing-force signals (gears on lateral bearings)."""
+        return sorted({k.split("_bearing_force_")[0] for k in self.signals if "_bearing_force_" in k})
+
+    def summary(self) -> dict[str, Any]:
+        """What a diagnostician reads first (the values of summary.json): K_d over the run and over its
+        final quarter (the steady, rated-load period of the four-period runs), separation, mesh frequency,
+        speed, solver statistics and bearing forces; whole-run values say so by having no '_final'."""
+        from .analysis import separation_stats
+
+        win = self.final_window()
+        sep = separation_stats(self.mesh_force, self.time_s, kd=self.kd)
+        speed = (
+            self["pinion_speed_rad_s"]
+            if "pinion_speed_rad_s" in self
+            else 2 * math.pi * self["mesh_frequency_hz"] / self.meta["pinion_teeth"]
+        )
+        stats = self.meta.get("solver_statistics", {})
+        return {
+            "scene": self.meta.get("scene"),
+            "kd_max": float(np.max(self.kd)),
+            "kd_min": float(np.min(self.kd)),
+            "kd_max_final": float(np.max(self.kd[win])),
+            "kd_mean_final": float(np.mean(self.kd[win])),
+            "kd_above_2": bool(np.max(self.kd) > 2.0),
+            "separation_fraction": float(sep.separated_fraction),
+            "contact_losses": int(sep.contact_losses),
+            "mesh_frequency_hz": float(np.mean(self["mesh_frequency_hz"][win])),
+            "mean_speed_rad_s": float(np.mean(speed[win])),
+            "rated_mesh_force_N": float(self.meta.get("rated_mesh_force_N", float("nan"))),
+            "simulated_time_s": float(self.time_s[-1] - self.time_s[0]),
+            "wall_time_s": float(stats.get("wall_time_s", float("nan"))),
+            "wall_s_per_simulated_s": float(stats.get("wall_time_s", float("nan")))
+            / max(float(self.time_s[-1] - self.time_s[0]), 1e-300),
+            "solver_steps": int(stats.get("steps", 0)),
+            "solver_rejected_steps": int(stats.get("rejected_steps", 0)),
+            "seed": self.meta.get("seed"),
+            **{
+                f"{gear}_bearing_force_{axis}_max_N": float(
+                    np.max(np.abs(self[f"{gear}_bearing_force_{axis}_N"]))
+                )
+                for gear in self.bearing_gears
+                for axis in "xy"
+            },
+            **{
+                f"{gear}_housing_accel_{axis}_rms_final_m_s2": float(
+                    np.std(self[f"{gear}_housing_accel_{axis}_m_s2"][win])
+                )
+                for gear in self.bearing_gears
+                for axis in "xy"
+            },
+        }
+
+    def plot(self, out_dir: str | Path) -> list[Path]:
+        """The run's standard PNGs in ``out_dir``: K_d over time, K_d folded over the mesh period, the
+        spectrum of the vibration signal, bearing forces (gearbody.plotting.run)."""
+        from .plotting.run import write_plots
+
+        Path(out_dir).mkdir(parents=True, exist_ok=True)
+        return write_plots(self, out_dir)
 
     def _stage(self, stage: int) -> dict[str, Any]:
         stages = self.meta.get("stages") or []

@@ -47,8 +47,6 @@ def register(sub) -> argparse.ArgumentParser:
 def execute(args) -> int:
     from gearbody.engine import simulate
     from gearbody.model import dump_scenario
-    from gearbody.plotting.run import write_plots
-    from gearbody.reports.summary import summarize
 
     overrides = scenario_overrides(args)
     scenario = load(args.scene, overrides)
@@ -58,10 +56,10 @@ def execute(args) -> int:
     result = simulate(scenario, progress=not args.quiet)
     result.save_npz(out / "result.npz")
     dump_scenario(scenario, out / "scenario.toml")
-    summary = summarize(result)
+    summary = result.summary()
     summary["wall_time_s"] = time.perf_counter() - t0
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    plots = [] if args.no_plots else write_plots(result, out)
+    plots = [] if args.no_plots else result.plot(out)
     if args.report:
         from gearbody.reports.html import write_report
 

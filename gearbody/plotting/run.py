@@ -4,18 +4,14 @@ the spectrum of the vibration signal and, for lateral gears, the bearing forces.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from gearbody.analysis import amplitude_spectrum, fold_over_mesh_period
-from gearbody.reports.summary import (
-    FINAL_FRACTION,
-    bearing_gears,
-    final_window,
-    pinion_angle,
-    vibration_signal,
-)
-from gearbody.result import Result
+
+if TYPE_CHECKING:  # Result.plot() calls this module
+    from gearbody.result import Result
 
 from .result import plot_kd_folded, plot_kd_time, plot_signals, plot_spectrum
 
@@ -31,23 +27,23 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
             result.time_s, result.kd, out / "kd_time.png", title=f"{title}: K_d = F(t)/F_rated"
         )
     ]
-    win = final_window(result)
+    win = result.final_window()  # the steady end of the run (Result.FINAL_FRACTION)
     f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
     # at most one bin per sample of a mesh period, so that every bin is filled
     bins = int(np.clip(result.sample_rate_hz / max(f_mesh, 1e-9), 10, 100))
     folded = fold_over_mesh_period(
-        result.kd[win], pinion_angle(result)[win], int(result.meta["pinion_teeth"]), bins=bins
+        result.kd[win], result["pinion_angle_rad"][win], result.teeth(0)[0], bins=bins
     )
     paths.append(
         plot_kd_folded(
             folded,
             out / "kd_folded.png",
-            title=f"{title}: K_d over the mesh period (last {FINAL_FRACTION:.0%} of run)",
+            title=f"{title}: K_d over the mesh period (last {result.FINAL_FRACTION:.0%} of run)",
         )
     )
-    name, signal = vibration_signal(result)
-    spec = amplitude_spectrum(signal[win], result.sample_rate_hz)
-    z1, z2 = int(result.meta["pinion_teeth"]), int(result.meta["wheel_teeth"])
+    name = result.vibration_signal_name
+    spec = amplitude_spectrum(result[name][win], result.sample_rate_hz)
+    z1, z2 = result.teeth(0)
     shafts = {"f_1": f_mesh / z1, "f_2": f_mesh / z2} if f_mesh > 0 else {}
     unit = "rad/s²" if name.endswith("rad_s2") else "m/s²"
     paths.append(
@@ -62,7 +58,7 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
             log_amplitude=True,
         )
     )
-    gears = bearing_gears(result)
+    gears = result.bearing_gears
     if gears:
         paths.append(
             plot_signals(

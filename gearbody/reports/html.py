@@ -27,8 +27,6 @@ from gearbody.plotting.figure import png_base64
 from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure, tsa_figure
 from gearbody.result import Result
 
-from .summary import FINAL_FRACTION, final_window, summarize, vibration_signal
-
 __all__ = ["report_sections", "write_report"]
 
 MIN_TSA_REVOLUTIONS = 2
@@ -57,9 +55,10 @@ def _table(rows: list[dict[str, Any]], columns: list[str] | None = None) -> str:
 
 def report_sections(result: Result) -> dict[str, Any]:
     """The report's content as data: summary, labelled peaks, indicators, and figures (base64 PNG)."""
-    win = final_window(result)
-    summary = summarize(result)
-    name, signal = vibration_signal(result)
+    win = result.final_window()
+    summary = result.summary()
+    name = result.vibration_signal_name
+    signal = result[name]
     z1 = int(result.meta["pinion_teeth"])
     stages = result.meta.get("stages") or [{"pinion_teeth": z1, "wheel_teeth": result.meta["wheel_teeth"]}]
     teeth = [(int(s["pinion_teeth"]), int(s["wheel_teeth"])) for s in stages]
@@ -86,7 +85,7 @@ def report_sections(result: Result) -> dict[str, Any]:
     if f_mesh > 0:
         bins = int(np.clip(result.sample_rate_hz / f_mesh, 10, 100))
         folded = fold_over_mesh_period(result.kd[win], result["pinion_angle_rad"][win], z1, bins=bins)
-        title = f"K_d over the mesh period (last {FINAL_FRACTION:.0%} of the run)"
+        title = f"K_d over the mesh period (last {result.FINAL_FRACTION:.0%} of the run)"
         fig = kd_folded_figure(folded, title=title)
         out["figures"]["kd_folded"] = png_base64(fig)
 
@@ -124,7 +123,8 @@ def write_report(result: Result, path: str | Path) -> Path:
         f"<h1>{title}</h1>",
         f"<p>scene <code>{html.escape(str(result.meta.get('scene', '')))}</code>, gearbody "
         f"{html.escape(str(result.meta.get('gearbody_version', '')))}; analysed window: the last "
-        f"{FINAL_FRACTION:.0%} of the run; vibration signal <code>{html.escape(s['signal'])}</code>.</p>",
+        f"{result.FINAL_FRACTION:.0%} of the run; vibration signal "
+        f"<code>{html.escape(s['signal'])}</code>.</p>",
         "<h2>Summary</h2>",
         _table(summary_rows),
         "<h2>K_d over the mesh period</h2>",

@@ -27,10 +27,9 @@ def run_case(base: Mapping[str, Any], overrides: Sequence[str], keep_result: boo
     try:
         from gearbody.engine import simulate
         from gearbody.model import load_scenario
-        from gearbody.reports.summary import summarize
 
         result = simulate(load_scenario(dict(base), list(overrides)))
-        summary = summarize(result)
+        summary = result.summary()
         wall = time.perf_counter() - t0
         summary["wall_time_s"] = wall
         return {
