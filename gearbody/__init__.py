@@ -4,7 +4,7 @@ After W. Bartelmus, *Mathematical modelling and computer simulations as an aid t
 diagnostics*, Mechanical Systems and Signal Processing 15(5), 2001.
 """
 
-__version__ = "0.1.0"
+from .version import __version__
 
 from .errors import GearbodyError, InputError, ScenarioError, SimulationError  # noqa: E402
 from .model import (  # noqa: E402

@@ -17,7 +17,7 @@ import exudyn.solver
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
-from .. import __version__
+from ..version import __version__
 from ..analysis.antialias import band_limited_samples
 from ..assembly import (
     gear_names,

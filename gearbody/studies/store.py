@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from gearbody import __version__
+from gearbody.version import __version__
 from gearbody.model import Scenario, dump_scenario
 
 from .parse import SweepSpecError
