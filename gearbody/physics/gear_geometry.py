@@ -35,10 +35,10 @@ Equations (gear k = 1 pinion, 2 wheel; h_a*, h_f* addendum/dedendum coefficients
   uses cos(alpha_t) cos(beta_b) / cos(beta) = cos(alpha_n)); along the transverse line of action
   ``j_bt = j_bn / cos(beta_b)``; gearbody's eq. (4) half-width ``l_u = j_bt / 2`` (= j_bn / 2 for spur).
 
-Checks (:class:`GearGeometryError`, a :class:`~gearbody.model.params.ScenarioError`, naming parameter,
-value and allowed range): positive inputs, undercut, centre distance vs shifts, tip thickness
-``s_an >= 0.2 m_n``, tip-root clearance ``>= 0``, interference (contact start before T1 or end beyond T2,
-or into the non-involute root below rho_F), ``eps_alpha >= 1``.
+Checks (:class:`~gearbody.physics.exceptions.GearGeometryError`, a ``ValueError`` that the model turns
+into a ``ScenarioError``, naming parameter, value and allowed range): positive inputs, undercut, centre
+distance vs shifts, tip thickness ``s_an >= 0.2 m_n``, tip-root clearance ``>= 0``, interference (contact
+start before T1 or end beyond T2, or into the non-involute root below rho_F), ``eps_alpha >= 1``.
 
 Mesh-phase convention of gearbody (docs/scenario.md; :func:`gearbody.physics.mesh.stiffness_at_phase`):
 one mesh period is one transverse base pitch of travel along the line of action; the pair assigned to a
@@ -58,19 +58,22 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from gearbody.model.params import ScenarioError
+from .exceptions import GearGeometryError, geometry_error
 
 MIN_TIP_THICKNESS_MODULES = 0.2  # s_an >= 0.2 m_n (common design limit; 0.2-0.4 m_n)
 CENTRE_DISTANCE_TOLERANCE_MODULES = 0.005  # |a_w - a_w(x1 + x2)| <= 0.005 m_n unless told otherwise
 
 
-class GearGeometryError(ScenarioError):
-    """Impossible or unsound gear-pair geometry; the message names parameter, value and allowed range."""
-
-
-def _fail(name: str, value: float, reason: str, allowed: str) -> GearGeometryError:
-    shown = f"{value:.6g}" if isinstance(value, float) else repr(value)
-    return GearGeometryError(f"{name} = {shown}: {reason}; allowed: {allowed}")
+__all__ = [
+    "GearGeometryError",
+    "GearPairGeometry",
+    "backlash_half_width_m",
+    "backlash_range_m",
+    "gear_pair_geometry",
+    "inverse_involute",
+    "involute",
+    "normal_backlash_m",
+]
 
 
 def involute(angle_rad: float) -> float:
@@ -245,7 +248,7 @@ def gear_pair_geometry(
         if z < z_min:
             shift = "profile_shift_pinion" if name == "teeth_pinion" else "profile_shift_wheel"
             x_min = ha - z * math.sin(alpha_t) ** 2 / (2.0 * math.cos(beta))
-            raise _fail(
+            raise geometry_error(
                 name, z, f"undercut with {shift} = {x:g}", f">= {z_min:.4g} teeth, or {shift} >= {x_min:.4g}"
             )
 
@@ -253,7 +256,7 @@ def gear_pair_geometry(
     inv_wt = involute(alpha_t) + 2.0 * math.tan(alpha_n) * (x1 + x2) / (z1 + z2)
     if inv_wt <= 0.0:
         x_lim = -involute(alpha_t) * (z1 + z2) / (2.0 * math.tan(alpha_n))
-        raise _fail(
+        raise geometry_error(
             "profile_shift_pinion + profile_shift_wheel",
             x1 + x2,
             "no working pressure angle",
@@ -269,7 +272,7 @@ def gear_pair_geometry(
             else centre_distance_tolerance_m
         )
         if abs(centre_distance_m - a_w_shifts) > tol:
-            raise _fail(
+            raise geometry_error(
                 "centre_distance_m",
                 float(centre_distance_m),
                 f"does not match the profile shifts x1 + x2 = {x1 + x2:g} "
@@ -277,7 +280,7 @@ def gear_pair_geometry(
                 f"[{a_w_shifts - tol:.6g}, {a_w_shifts + tol:.6g}] m",
             )
         if centre_distance_m <= a * math.cos(alpha_t):
-            raise _fail(
+            raise geometry_error(
                 "centre_distance_m",
                 float(centre_distance_m),
                 "below the base-circle sum",
@@ -291,7 +294,7 @@ def gear_pair_geometry(
         ra1, ra2 = 0.5 * tip_diameters_m[0], 0.5 * tip_diameters_m[1]
         for name, ra, r in (("tip_diameters_m[0]", ra1, r1), ("tip_diameters_m[1]", ra2, r2)):
             if not ra > r:
-                raise _fail(
+                raise geometry_error(
                     name, 2.0 * ra, "tip diameter not above the reference diameter", f"> {2.0 * r:.6g} m"
                 )
     else:
@@ -307,14 +310,14 @@ def gear_pair_geometry(
     rho_f1 = r1 * math.sin(alpha_t) - (ha - x1) * mn / math.sin(alpha_t)
     rho_f2 = r2 * math.sin(alpha_t) - (ha - x2) * mn / math.sin(alpha_t)
     if s_a < 0.0:
-        raise _fail(
+        raise geometry_error(
             "tip_radius_wheel_m",
             ra2,
             "contact starts before T1 (interference below the pinion base circle)",
             f"<= {math.hypot(t1t2, rb2):.6g} m",
         )
     if s_e > t1t2:
-        raise _fail(
+        raise geometry_error(
             "tip_radius_pinion_m",
             ra1,
             "contact ends beyond T2 (interference below the wheel base circle)",
@@ -329,7 +332,7 @@ def gear_pair_geometry(
         if san < s_min:
             if tip_diameters_m is not None:
                 name, x = f"tip_diameters_m[{i}]", float(tip_diameters_m[i])
-            raise _fail(
+            raise geometry_error(
                 name,
                 x,
                 f"tip too thin, normal tip thickness {san:.4g} m",
@@ -337,7 +340,7 @@ def gear_pair_geometry(
             )
     for name, clearance in (("tip_radius_pinion", a_w - ra1 - rf2), ("tip_radius_wheel", a_w - ra2 - rf1)):
         if clearance < 0.0:
-            raise _fail(
+            raise geometry_error(
                 "centre_distance_m",
                 a_w,
                 f"{name} reaches {-clearance:.4g} m into the mating root (try tip_shortening=True)",
@@ -346,7 +349,7 @@ def gear_pair_geometry(
 
     if s_a < rho_f1:
         limit = math.hypot(t1t2 - rho_f1, rb2)
-        raise _fail(
+        raise geometry_error(
             "tip_radius_wheel_m",
             ra2,
             "contact starts below the generated involute of the pinion (root interference)",
@@ -354,7 +357,7 @@ def gear_pair_geometry(
         )
     if t1t2 - s_e < rho_f2:
         limit = math.hypot(t1t2 - rho_f2, rb1)
-        raise _fail(
+        raise geometry_error(
             "tip_radius_pinion_m",
             ra1,
             "contact ends below the generated involute of the wheel (root interference)",
@@ -362,7 +365,9 @@ def gear_pair_geometry(
         )
     eps_alpha = (s_e - s_a) / pbt
     if eps_alpha < 1.0:
-        raise _fail("transverse_contact_ratio", eps_alpha, "less than one pair always in contact", ">= 1")
+        raise geometry_error(
+            "transverse_contact_ratio", eps_alpha, "less than one pair always in contact", ">= 1"
+        )
 
     return GearPairGeometry(
         module_m=mn,
@@ -417,20 +422,22 @@ def _normal_tip_thickness_m(z, x, r, rb, ra, alpha_n, alpha_t, beta) -> float:
 
 def _check_inputs(mn, z1, z2, b, alpha_deg, beta_deg, ha, hf, shifts, a_w) -> None:
     if not (isinstance(mn, (int, float)) and mn > 0.0 and math.isfinite(mn)):
-        raise _fail("module_m", mn, "module must be positive", "> 0 m")
+        raise geometry_error("module_m", mn, "module must be positive", "> 0 m")
     for name, z in (("teeth_pinion", z1), ("teeth_wheel", z2)):
         if isinstance(z, bool) or int(z) != z or z < 5:
-            raise _fail(name, z, "tooth count must be a whole number of at least 5", "integer >= 5")
+            raise geometry_error(name, z, "tooth count must be a whole number of at least 5", "integer >= 5")
     if not b > 0.0:
-        raise _fail("face_width_m", b, "face width must be positive", "> 0 m")
+        raise geometry_error("face_width_m", b, "face width must be positive", "> 0 m")
     if not 0.0 < alpha_deg < 45.0:
-        raise _fail("pressure_angle_deg", alpha_deg, "normal pressure angle out of range", "> 0 and < 45")
+        raise geometry_error(
+            "pressure_angle_deg", alpha_deg, "normal pressure angle out of range", "> 0 and < 45"
+        )
     if not -45.0 < beta_deg < 45.0:
-        raise _fail("helix_angle_deg", beta_deg, "helix angle out of range", "> -45 and < 45")
+        raise geometry_error("helix_angle_deg", beta_deg, "helix angle out of range", "> -45 and < 45")
     if not ha > 0.0:
-        raise _fail("addendum_coefficient", ha, "addendum must be positive", "> 0")
+        raise geometry_error("addendum_coefficient", ha, "addendum must be positive", "> 0")
     if not hf >= ha:
-        raise _fail(
+        raise geometry_error(
             "dedendum_coefficient",
             hf,
             "dedendum below the addendum (negative bottom clearance)",
@@ -438,9 +445,9 @@ def _check_inputs(mn, z1, z2, b, alpha_deg, beta_deg, ha, hf, shifts, a_w) -> No
         )
     for name, x in zip(("profile_shift_pinion", "profile_shift_wheel"), shifts, strict=True):
         if not math.isfinite(x):
-            raise _fail(name, x, "profile shift must be finite", "finite")
+            raise geometry_error(name, x, "profile shift must be finite", "finite")
     if a_w is not None and not a_w > 0.0:
-        raise _fail("centre_distance_m", a_w, "centre distance must be positive", "> 0 m")
+        raise geometry_error("centre_distance_m", a_w, "centre distance must be positive", "> 0 m")
 
 
 def normal_backlash_m(
@@ -484,7 +491,7 @@ def backlash_range_m(
         ("centre_distance_allowances_m", centre_distance_allowances_m),
     ):
         if upper < lower:
-            raise _fail(
+            raise geometry_error(
                 name,
                 (upper, lower),
                 "upper allowance below the lower one",
@@ -503,7 +510,7 @@ def backlash_range_m(
         centre_distance_deviation_m=centre_distance_allowances_m[0],
     )
     if j_min < 0.0:
-        raise _fail(
+        raise geometry_error(
             "normal_backlash_min_m", j_min, "the teeth jam at the upper thickness allowances", ">= 0 m"
         )
     return j_min, j_max
