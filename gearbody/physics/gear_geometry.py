@@ -62,17 +62,21 @@ from .exceptions import GearGeometryError, geometry_error
 
 MIN_TIP_THICKNESS_MODULES = 0.2  # s_an >= 0.2 m_n (common design limit; 0.2-0.4 m_n)
 CENTRE_DISTANCE_TOLERANCE_MODULES = 0.005  # |a_w - a_w(x1 + x2)| <= 0.005 m_n unless told otherwise
+_INVERSE_INVOLUTE_BRACKET_RAD = (1e-6, 1.5)
 
 
 __all__ = [
     "GearGeometryError",
     "GearPairGeometry",
+    "GearRadii",
     "backlash_half_width_m",
     "backlash_range_m",
     "gear_pair_geometry",
+    "gear_radii",
     "inverse_involute",
     "involute",
     "normal_backlash_m",
+    "transverse_module_and_pressure_angle",
 ]
 
 
@@ -82,10 +86,64 @@ def involute(angle_rad: float) -> float:
 
 
 def inverse_involute(value: float) -> float:
-    """Angle a in (0, pi/2) with inv(a) = value (value > 0)."""
+    """Angle a in [1e-6, 1.5] rad with inv(a) = value (0 < value <= inv(1.5) = 12.6)."""
+    lo, hi = _INVERSE_INVOLUTE_BRACKET_RAD
     if value <= 0.0:
         raise ValueError(f"inverse_involute: value = {value:g} must be > 0")
-    return brentq(lambda a: involute(a) - value, 1e-9, 0.5 * math.pi - 1e-9, xtol=1e-15, rtol=1e-15)
+    if not involute(lo) <= value <= involute(hi):
+        raise ValueError(f"inverse_involute: value = {value:g} outside [inv({lo:g}), inv({hi:g})]")
+    return brentq(lambda a: involute(a) - value, lo, hi, xtol=1e-15)
+
+
+def transverse_module_and_pressure_angle(
+    module_m: float, pressure_angle_rad: float, helix_angle_rad: float
+) -> tuple[float, float]:
+    """(m_t, alpha_t): ``m_n / cos(beta)`` and ``atan(tan(alpha_n) / cos(beta))``; exactly (m_n, alpha_n)
+    for spur gears."""
+    if helix_angle_rad == 0.0:
+        return module_m, pressure_angle_rad
+    return (
+        module_m / math.cos(helix_angle_rad),
+        math.atan(math.tan(pressure_angle_rad) / math.cos(helix_angle_rad)),
+    )
+
+
+def _pitch_base_root_radii_m(z, x, mn, mt, alpha_t, hf) -> tuple[float, float, float]:
+    r = 0.5 * z * mt
+    return r, r * math.cos(alpha_t), r - mn * (hf - x)
+
+
+def _tip_radius_m(r, x, mn, ha, k=0.0) -> float:
+    return r + mn * (ha + x + k)
+
+
+@dataclasses.dataclass(frozen=True)
+class GearRadii:
+    """Reference (pitch), base, tip and root radius of one gear, m."""
+
+    pitch_m: float
+    base_m: float
+    tip_m: float
+    root_m: float
+
+
+def gear_radii(
+    *,
+    teeth: int,
+    module_m: float,
+    pressure_angle_deg: float = 20.0,
+    helix_angle_deg: float = 0.0,
+    profile_shift: float = 0.0,
+    addendum_coefficient: float = 1.0,
+    dedendum_coefficient: float = 1.25,
+) -> GearRadii:
+    """Radii of one gear (module docstring: r, r_b, r_a without tip alteration, r_f); no checks. The same
+    arithmetic as :func:`gear_pair_geometry`, which also checks the pair."""
+    alpha_n, beta = math.radians(pressure_angle_deg), abs(math.radians(helix_angle_deg))
+    mt, alpha_t = transverse_module_and_pressure_angle(module_m, alpha_n, beta)
+    x = profile_shift
+    r, rb, rf = _pitch_base_root_radii_m(teeth, x, module_m, mt, alpha_t, dedendum_coefficient)
+    return GearRadii(r, rb, _tip_radius_m(r, x, module_m, addendum_coefficient), rf)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -237,11 +295,10 @@ def gear_pair_geometry(
     mn, z1, z2 = module_m, int(teeth_pinion), int(teeth_wheel)
     x1, x2, ha, hf = profile_shift_pinion, profile_shift_wheel, addendum_coefficient, dedendum_coefficient
     alpha_n, beta = math.radians(pressure_angle_deg), abs(math.radians(helix_angle_deg))
-    mt = mn / math.cos(beta)
-    alpha_t = math.atan(math.tan(alpha_n) / math.cos(beta))
+    mt, alpha_t = transverse_module_and_pressure_angle(mn, alpha_n, beta)
     beta_b = math.atan(math.tan(beta) * math.cos(alpha_t))
-    r1, r2 = 0.5 * z1 * mt, 0.5 * z2 * mt
-    rb1, rb2 = r1 * math.cos(alpha_t), r2 * math.cos(alpha_t)
+    r1, rb1, rf1 = _pitch_base_root_radii_m(z1, x1, mn, mt, alpha_t, hf)
+    r2, rb2, rf2 = _pitch_base_root_radii_m(z2, x2, mn, mt, alpha_t, hf)
 
     for name, z, x in (("teeth_pinion", z1, x1), ("teeth_wheel", z2, x2)):
         z_min = 2.0 * (ha - x) * math.cos(beta) / math.sin(alpha_t) ** 2
@@ -253,7 +310,8 @@ def gear_pair_geometry(
             )
 
     a = r1 + r2
-    inv_wt = involute(alpha_t) + 2.0 * math.tan(alpha_n) * (x1 + x2) / (z1 + z2)
+    inv_t = involute(alpha_t)
+    inv_wt = inv_t + 2.0 * math.tan(alpha_n) * (x1 + x2) / (z1 + z2)
     if inv_wt <= 0.0:
         x_lim = -involute(alpha_t) * (z1 + z2) / (2.0 * math.tan(alpha_n))
         raise geometry_error(
@@ -262,9 +320,11 @@ def gear_pair_geometry(
             "no working pressure angle",
             f"> {x_lim:.4g}",
         )
-    a_w_shifts = a * math.cos(alpha_t) / math.cos(inverse_involute(inv_wt))
+    # shifts summing to (about) zero: alpha_wt = alpha_t exactly, not the solver's approximation
+    alpha_wt_shifts = alpha_t if abs(inv_wt - inv_t) < 1e-15 else inverse_involute(inv_wt)
+    a_w_shifts = a * math.cos(alpha_t) / math.cos(alpha_wt_shifts)
     if centre_distance_m is None:
-        a_w = a_w_shifts
+        a_w, alpha_wt = a_w_shifts, alpha_wt_shifts
     else:
         tol = (
             CENTRE_DISTANCE_TOLERANCE_MODULES * mn
@@ -287,7 +347,7 @@ def gear_pair_geometry(
                 f"> {a * math.cos(alpha_t):.6g} m",
             )
         a_w = float(centre_distance_m)
-    alpha_wt = math.acos(a * math.cos(alpha_t) / a_w)
+        alpha_wt = math.acos(a * math.cos(alpha_t) / a_w)
     k = (a_w - a) / mn - (x1 + x2)
 
     if tip_diameters_m is not None:
@@ -299,10 +359,9 @@ def gear_pair_geometry(
                 )
     else:
         shortening = k if (tip_shortening and k < 0.0) else 0.0
-        ra1, ra2 = r1 + mn * (ha + x1 + shortening), r2 + mn * (ha + x2 + shortening)
-    rf1, rf2 = r1 - mn * (hf - x1), r2 - mn * (hf - x2)
+        ra1, ra2 = _tip_radius_m(r1, x1, mn, ha, shortening), _tip_radius_m(r2, x2, mn, ha, shortening)
 
-    pbt = math.pi * mt * math.cos(alpha_t)
+    pbt = 2.0 * math.pi * rb1 / z1  # = pi m_t cos(alpha_t)
     t1t2 = a_w * math.sin(alpha_wt)
     s_e = math.sqrt(ra1**2 - rb1**2)
     s_a = t1t2 - math.sqrt(ra2**2 - rb2**2)
