@@ -17,8 +17,8 @@ Equations (gear k = 1 pinion, 2 wheel; h_a*, h_f* addendum/dedendum coefficients
   ``cos(alpha_wt) = a cos(alpha_t) / a_w``
   and it must agree with the shifts within ``centre_distance_tolerance_m`` (default 0.005 m_n); the
   difference is the design's centre-distance backlash, ``k = (a_w - a)/m_n - (x1 + x2)``;
-- transverse base pitch ``p_bt = pi m_t cos(alpha_t)``; line of action ``T1T2 = a_w sin(alpha_wt)``;
-  points measured from T1 (tangent point on the pinion base circle):
+- transverse base pitch ``p_bt = pi m_t cos(alpha_t) = 2 pi r_b1 / z1``; line of action
+  ``T1T2 = a_w sin(alpha_wt)``; points measured from T1 (tangent point on the pinion base circle):
   ``E = sqrt(r_a1² - r_b1²)`` (pinion tip, end of contact), ``A = T1T2 - sqrt(r_a2² - r_b2²)``
   (wheel tip, start of contact), ``C = r_b1 tan(alpha_wt)``, ``B = E - p_bt``, ``D = A + p_bt``;
 - ``eps_alpha = (E - A) / p_bt`` (= g_alpha / p_bt), ``eps_beta = b sin(beta) / (pi m_n)``,
@@ -29,41 +29,43 @@ Equations (gear k = 1 pinion, 2 wheel; h_a*, h_f* addendum/dedendum coefficients
 - normal tip thickness ``s_an = s_at cos(beta_a)``,
   ``s_at = d_a [(pi + 4 x tan(alpha_n)) / (2 z) + inv(alpha_t) - inv(alpha_at)]``,
   ``cos(alpha_at) = r_b / r_a``, ``tan(beta_a) = tan(beta) r_a / r``;
-- backlash (Niemann & Winter; ISO/TR 10064-2): base normal backlash
-  ``j_bn = -(E_sn1 + E_sn2) cos(alpha_n) + 2 Delta_a sin(alpha_wt) cos(beta_b)``
-  (E_sn: normal tooth-thickness allowance, negative = thinner; Delta_a: centre-distance deviation;
-  uses cos(alpha_t) cos(beta_b) / cos(beta) = cos(alpha_n)); along the transverse line of action
-  ``j_bt = j_bn / cos(beta_b)``; gearbody's eq. (4) half-width ``l_u = j_bt / 2`` (= j_bn / 2 for spur).
+- backlash: :mod:`.gear_backlash`.
+
+Arithmetic (kept to the last bit, the potential-energy pair table depends on it): spur gears take
+``m_t = m_n`` and ``alpha_t = alpha_n`` as they are; shifts summing to zero give ``alpha_wt = alpha_t``
+exactly, other shifts the root of the involute equation (no ``acos`` round trip); ``p_bt = 2 pi r_b1 / z1``.
 
 Checks (:class:`~gearbody.physics.exceptions.GearGeometryError`, a ``ValueError`` that the model turns
 into a ``ScenarioError``, naming parameter, value and allowed range): positive inputs, undercut, centre
 distance vs shifts, tip thickness ``s_an >= 0.2 m_n``, tip-root clearance ``>= 0``, interference (contact
 start before T1 or end beyond T2, or into the non-involute root below rho_F), ``eps_alpha >= 1``.
 
-Mesh-phase convention of gearbody (docs/scenario.md; :func:`gearbody.physics.mesh.stiffness_at_phase`):
-one mesh period is one transverse base pitch of travel along the line of action; the pair assigned to a
-period passes the middle of the single-contact zone, ``(B + D)/2 = (A + E)/2``, at p = 0.5, so its contact
-runs over ``-h <= p < 1 + h`` with ``h = (eps_alpha - 1)/2``; contact point
-``s(p) = (A + E)/2 + (p - 0.5) p_bt``.
-Friction arms are the radii of curvature of the flanks at the contact point (the distance to each
-gear's base tangent point, not to the pitch point): ``rho_1 = s``, ``rho_2 = T1T2 - s``; at the pitch point
-``rho_1 = r_b1 tan(alpha_wt)``, as in mesh.py.
+Module map: :mod:`.involute` (involute function, radii and tip thickness of one gear),
+:mod:`.gear_pair` (the result, :class:`GearPairGeometry`, and the mesh-phase convention),
+:mod:`.gear_backlash` (backlash); this module builds the pair and checks it, and re-exports the others'
+public names.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
-import numpy as np
-from scipy.optimize import brentq
-
 from .exceptions import GearGeometryError, geometry_error
+from .gear_backlash import backlash_half_width_m, backlash_range_m, normal_backlash_m
+from .gear_pair import GearPairGeometry
+from .involute import (
+    GearRadii,
+    gear_radii,
+    inverse_involute,
+    involute,
+    normal_tip_thickness_m,
+    pitch_base_root_radii_m,
+    tip_radius_m,
+    transverse_module_and_pressure_angle,
+)
 
 MIN_TIP_THICKNESS_MODULES = 0.2  # s_an >= 0.2 m_n (common design limit; 0.2-0.4 m_n)
 CENTRE_DISTANCE_TOLERANCE_MODULES = 0.005  # |a_w - a_w(x1 + x2)| <= 0.005 m_n unless told otherwise
-_INVERSE_INVOLUTE_BRACKET_RAD = (1e-6, 1.5)
-
 
 __all__ = [
     "GearGeometryError",
@@ -78,182 +80,6 @@ __all__ = [
     "normal_backlash_m",
     "transverse_module_and_pressure_angle",
 ]
-
-
-def involute(angle_rad: float) -> float:
-    """Involute function inv(a) = tan(a) - a."""
-    return math.tan(angle_rad) - angle_rad
-
-
-def inverse_involute(value: float) -> float:
-    """Angle a in [1e-6, 1.5] rad with inv(a) = value (0 < value <= inv(1.5) = 12.6)."""
-    lo, hi = _INVERSE_INVOLUTE_BRACKET_RAD
-    if value <= 0.0:
-        raise ValueError(f"inverse_involute: value = {value:g} must be > 0")
-    if not involute(lo) <= value <= involute(hi):
-        raise ValueError(f"inverse_involute: value = {value:g} outside [inv({lo:g}), inv({hi:g})]")
-    return brentq(lambda a: involute(a) - value, lo, hi, xtol=1e-15)
-
-
-def transverse_module_and_pressure_angle(
-    module_m: float, pressure_angle_rad: float, helix_angle_rad: float
-) -> tuple[float, float]:
-    """(m_t, alpha_t): ``m_n / cos(beta)`` and ``atan(tan(alpha_n) / cos(beta))``; exactly (m_n, alpha_n)
-    for spur gears."""
-    if helix_angle_rad == 0.0:
-        return module_m, pressure_angle_rad
-    return (
-        module_m / math.cos(helix_angle_rad),
-        math.atan(math.tan(pressure_angle_rad) / math.cos(helix_angle_rad)),
-    )
-
-
-def _pitch_base_root_radii_m(z, x, mn, mt, alpha_t, hf) -> tuple[float, float, float]:
-    r = 0.5 * z * mt
-    return r, r * math.cos(alpha_t), r - mn * (hf - x)
-
-
-def _tip_radius_m(r, x, mn, ha, k=0.0) -> float:
-    return r + mn * (ha + x + k)
-
-
-@dataclasses.dataclass(frozen=True)
-class GearRadii:
-    """Reference (pitch), base, tip and root radius of one gear, m."""
-
-    pitch_m: float
-    base_m: float
-    tip_m: float
-    root_m: float
-
-
-def gear_radii(
-    *,
-    teeth: int,
-    module_m: float,
-    pressure_angle_deg: float = 20.0,
-    helix_angle_deg: float = 0.0,
-    profile_shift: float = 0.0,
-    addendum_coefficient: float = 1.0,
-    dedendum_coefficient: float = 1.25,
-) -> GearRadii:
-    """Radii of one gear (module docstring: r, r_b, r_a without tip alteration, r_f); no checks. The same
-    arithmetic as :func:`gear_pair_geometry`, which also checks the pair."""
-    alpha_n, beta = math.radians(pressure_angle_deg), abs(math.radians(helix_angle_deg))
-    mt, alpha_t = transverse_module_and_pressure_angle(module_m, alpha_n, beta)
-    x = profile_shift
-    r, rb, rf = _pitch_base_root_radii_m(teeth, x, module_m, mt, alpha_t, dedendum_coefficient)
-    return GearRadii(r, rb, _tip_radius_m(r, x, module_m, addendum_coefficient), rf)
-
-
-@dataclasses.dataclass(frozen=True)
-class GearPairGeometry:
-    """Geometry of an external involute gear pair (pinion = gear 1); build it with :func:`gear_pair_geometry`.
-
-    Positions on the line of action (``*_position_m``) are distances from T1, the tangent point on the
-    pinion base circle, towards T2.
-    """
-
-    module_m: float  # normal module m_n
-    teeth_pinion: int
-    teeth_wheel: int
-    face_width_m: float
-    pressure_angle_rad: float  # normal pressure angle alpha_n
-    helix_angle_rad: float  # |beta| at the reference cylinder
-    profile_shift_pinion: float
-    profile_shift_wheel: float
-    addendum_coefficient: float
-    dedendum_coefficient: float
-    transverse_module_m: float
-    transverse_pressure_angle_rad: float  # alpha_t
-    base_helix_angle_rad: float  # beta_b
-    working_pressure_angle_rad: float  # alpha_wt, transverse
-    reference_centre_distance_m: float  # a = r1 + r2
-    centre_distance_m: float  # working a_w
-    tip_alteration_coefficient: float  # k = (a_w - a)/m_n - (x1 + x2)
-    pitch_radius_pinion_m: float
-    pitch_radius_wheel_m: float
-    base_radius_pinion_m: float
-    base_radius_wheel_m: float
-    tip_radius_pinion_m: float
-    tip_radius_wheel_m: float
-    root_radius_pinion_m: float
-    root_radius_wheel_m: float
-    tip_thickness_pinion_m: float  # normal, s_an
-    tip_thickness_wheel_m: float
-    transverse_base_pitch_m: float  # p_bt
-    line_of_action_length_m: float  # T1T2
-    contact_start_position_m: float  # A
-    single_start_position_m: float  # B
-    pitch_point_position_m: float  # C
-    single_end_position_m: float  # D
-    contact_end_position_m: float  # E
-    transverse_contact_ratio: float  # eps_alpha
-    overlap_ratio: float  # eps_beta
-
-    @property
-    def total_contact_ratio(self) -> float:
-        """eps_gamma = eps_alpha + eps_beta."""
-        return self.transverse_contact_ratio + self.overlap_ratio
-
-    @property
-    def working_pitch_radius_pinion_m(self) -> float:
-        """r_w1 = r_b1 / cos(alpha_wt)."""
-        return self.base_radius_pinion_m / math.cos(self.working_pressure_angle_rad)
-
-    @property
-    def working_pitch_radius_wheel_m(self) -> float:
-        """r_w2 = r_b2 / cos(alpha_wt)."""
-        return self.base_radius_wheel_m / math.cos(self.working_pressure_angle_rad)
-
-    @property
-    def path_of_contact_m(self) -> float:
-        """g_alpha = E - A."""
-        return self.contact_end_position_m - self.contact_start_position_m
-
-    @property
-    def half_double_contact(self) -> float:
-        """h = (eps_alpha - 1)/2: double contact for p < h or p >= 1 - h (when eps_alpha < 2)."""
-        return 0.5 * (self.transverse_contact_ratio - 1.0)
-
-    @property
-    def pitch_point_phase(self) -> float:
-        """Mesh phase at which the period's pair passes the pitch point C (0.5 + (C - (A+E)/2)/p_bt).
-
-        May lie outside [0, 1) for strongly unequal addendum paths; gearbody's scenario needs [0, 1].
-        """
-        return self.phase_at_position(self.pitch_point_position_m)
-
-    def position_on_line_of_action_m(self, phase: float | np.ndarray) -> float | np.ndarray:
-        """Contact point of the period's pair at mesh phase p, distance from T1: (A+E)/2 + (p - 0.5) p_bt."""
-        mid = 0.5 * (self.contact_start_position_m + self.contact_end_position_m)
-        return mid + (phase - 0.5) * self.transverse_base_pitch_m
-
-    def phase_at_position(self, position_m: float | np.ndarray) -> float | np.ndarray:
-        """Inverse of :meth:`position_on_line_of_action_m`."""
-        mid = 0.5 * (self.contact_start_position_m + self.contact_end_position_m)
-        return 0.5 + (position_m - mid) / self.transverse_base_pitch_m
-
-    def pairs_in_contact(self, phase: float) -> tuple[tuple[int, float], ...]:
-        """Tooth pairs in contact at mesh phase p in [0, 1): ``(offset, position_m)`` per pair, by offset.
-
-        Offset 0 is the period's pair, -1 the previous (outgoing, at its own phase p + 1), +1 the next
-        (incoming, at p - 1), and so on. A pair is in contact over ``-h <= own phase < 1 + h``; the bounds
-        are written as in ``stiffness_at_phase`` (previous pair: ``p < h``; next pair: ``p >= 1 - h``).
-        """
-        h = self.half_double_contact
-        reach = math.ceil(h) + 1
-        pairs = []
-        for k in range(-reach, reach + 1):
-            if k - h <= phase < (k + 1) + h:
-                pairs.append((k, float(self.position_on_line_of_action_m(phase - k))))
-        return tuple(pairs)
-
-    def friction_arms_m(
-        self, position_m: float | np.ndarray
-    ) -> tuple[float | np.ndarray, float | np.ndarray]:
-        """Friction arms (rho_1, rho_2) at a contact position s from T1: (s, T1T2 - s), m."""
-        return position_m, self.line_of_action_length_m - position_m
 
 
 def gear_pair_geometry(
@@ -297,8 +123,8 @@ def gear_pair_geometry(
     alpha_n, beta = math.radians(pressure_angle_deg), abs(math.radians(helix_angle_deg))
     mt, alpha_t = transverse_module_and_pressure_angle(mn, alpha_n, beta)
     beta_b = math.atan(math.tan(beta) * math.cos(alpha_t))
-    r1, rb1, rf1 = _pitch_base_root_radii_m(z1, x1, mn, mt, alpha_t, hf)
-    r2, rb2, rf2 = _pitch_base_root_radii_m(z2, x2, mn, mt, alpha_t, hf)
+    r1, rb1, rf1 = pitch_base_root_radii_m(z1, x1, mn, mt, alpha_t, hf)
+    r2, rb2, rf2 = pitch_base_root_radii_m(z2, x2, mn, mt, alpha_t, hf)
 
     for name, z, x in (("teeth_pinion", z1, x1), ("teeth_wheel", z2, x2)):
         z_min = 2.0 * (ha - x) * math.cos(beta) / math.sin(alpha_t) ** 2
@@ -359,7 +185,7 @@ def gear_pair_geometry(
                 )
     else:
         shortening = k if (tip_shortening and k < 0.0) else 0.0
-        ra1, ra2 = _tip_radius_m(r1, x1, mn, ha, shortening), _tip_radius_m(r2, x2, mn, ha, shortening)
+        ra1, ra2 = tip_radius_m(r1, x1, mn, ha, shortening), tip_radius_m(r2, x2, mn, ha, shortening)
 
     pbt = 2.0 * math.pi * rb1 / z1  # = pi m_t cos(alpha_t)
     t1t2 = a_w * math.sin(alpha_wt)
@@ -382,8 +208,8 @@ def gear_pair_geometry(
             "contact ends beyond T2 (interference below the wheel base circle)",
             f"<= {math.hypot(t1t2, rb1):.6g} m",
         )
-    san1 = _normal_tip_thickness_m(z1, x1, r1, rb1, ra1, alpha_n, alpha_t, beta)
-    san2 = _normal_tip_thickness_m(z2, x2, r2, rb2, ra2, alpha_n, alpha_t, beta)
+    san1 = normal_tip_thickness_m(z1, x1, r1, rb1, ra1, alpha_n, alpha_t, beta)
+    san2 = normal_tip_thickness_m(z2, x2, r2, rb2, ra2, alpha_n, alpha_t, beta)
     s_min = MIN_TIP_THICKNESS_MODULES * mn
     for i, (name, san, x) in enumerate(
         (("profile_shift_pinion", san1, x1), ("profile_shift_wheel", san2, x2))
@@ -468,17 +294,6 @@ def gear_pair_geometry(
     )
 
 
-def _normal_tip_thickness_m(z, x, r, rb, ra, alpha_n, alpha_t, beta) -> float:
-    alpha_at = math.acos(rb / ra)
-    s_at = (
-        2.0
-        * ra
-        * ((math.pi + 4.0 * x * math.tan(alpha_n)) / (2.0 * z) + involute(alpha_t) - involute(alpha_at))
-    )
-    beta_a = math.atan(math.tan(beta) * ra / r)
-    return s_at * math.cos(beta_a)
-
-
 def _check_inputs(mn, z1, z2, b, alpha_deg, beta_deg, ha, hf, shifts, a_w) -> None:
     if not (isinstance(mn, (int, float)) and mn > 0.0 and math.isfinite(mn)):
         raise geometry_error("module_m", mn, "module must be positive", "> 0 m")
@@ -507,69 +322,3 @@ def _check_inputs(mn, z1, z2, b, alpha_deg, beta_deg, ha, hf, shifts, a_w) -> No
             raise geometry_error(name, x, "profile shift must be finite", "finite")
     if a_w is not None and not a_w > 0.0:
         raise geometry_error("centre_distance_m", a_w, "centre distance must be positive", "> 0 m")
-
-
-def normal_backlash_m(
-    geometry: GearPairGeometry,
-    *,
-    thickness_allowance_pinion_m: float,
-    thickness_allowance_wheel_m: float,
-    centre_distance_deviation_m: float = 0.0,
-) -> float:
-    """Base normal backlash j_bn = -(E_sn1 + E_sn2) cos(alpha_n) + 2 Delta_a sin(alpha_wt) cos(beta_b), m.
-
-    E_sn: normal tooth-thickness allowances (negative = thinner teeth); Delta_a: deviation of the actual
-    from the nominal centre distance. Niemann & Winter, ISO/TR 10064-2 (first order in the deviations).
-    """
-    return -(thickness_allowance_pinion_m + thickness_allowance_wheel_m) * math.cos(
-        geometry.pressure_angle_rad
-    ) + 2.0 * centre_distance_deviation_m * math.sin(geometry.working_pressure_angle_rad) * math.cos(
-        geometry.base_helix_angle_rad
-    )
-
-
-def backlash_half_width_m(geometry: GearPairGeometry, normal_backlash: float) -> float:
-    """gearbody's l_u (``backlash_um`` * 1e-6): half the backlash along the transverse line of action,
-    j_bn / (2 cos(beta_b)) (= j_bn / 2 for spur gears)."""
-    return 0.5 * normal_backlash / math.cos(geometry.base_helix_angle_rad)
-
-
-def backlash_range_m(
-    geometry: GearPairGeometry,
-    *,
-    thickness_allowances_pinion_m: tuple[float, float],
-    thickness_allowances_wheel_m: tuple[float, float],
-    centre_distance_allowances_m: tuple[float, float] = (0.0, 0.0),
-) -> tuple[float, float]:
-    """(j_bn_min, j_bn_max), m, from (upper, lower) allowances E_sns, E_sni of each gear and (upper, lower)
-    centre-distance allowances. The least backlash (upper thickness allowances, lower centre distance)
-    must be >= 0, else the teeth jam."""
-    for name, (upper, lower) in (
-        ("thickness_allowances_pinion_m", thickness_allowances_pinion_m),
-        ("thickness_allowances_wheel_m", thickness_allowances_wheel_m),
-        ("centre_distance_allowances_m", centre_distance_allowances_m),
-    ):
-        if upper < lower:
-            raise geometry_error(
-                name,
-                (upper, lower),
-                "upper allowance below the lower one",
-                "(upper, lower) with upper >= lower",
-            )
-    j_min = normal_backlash_m(
-        geometry,
-        thickness_allowance_pinion_m=thickness_allowances_pinion_m[0],
-        thickness_allowance_wheel_m=thickness_allowances_wheel_m[0],
-        centre_distance_deviation_m=centre_distance_allowances_m[1],
-    )
-    j_max = normal_backlash_m(
-        geometry,
-        thickness_allowance_pinion_m=thickness_allowances_pinion_m[1],
-        thickness_allowance_wheel_m=thickness_allowances_wheel_m[1],
-        centre_distance_deviation_m=centre_distance_allowances_m[0],
-    )
-    if j_min < 0.0:
-        raise geometry_error(
-            "normal_backlash_min_m", j_min, "the teeth jam at the upper thickness allowances", ">= 0 m"
-        )
-    return j_min, j_max
