@@ -30,7 +30,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .errors import tooth_error_depths_m
+from .error_mode import tooth_error_depths_m
 from .motor import load_torque_at, motor_torque_at
 
 # Layout of the packed parameter array.
