@@ -5,7 +5,6 @@ import math
 import numpy as np
 import pytest
 
-from gearbody.model.params import ScenarioError
 from gearbody.physics import pack_mesh_parameters, stiffness_at_phase
 from gearbody.physics.gear_geometry import (
     GearGeometryError,
@@ -310,5 +309,5 @@ def test_interference_is_refused():
 def test_bad_inputs_are_refused_naming_the_parameter(key, value):
     kw = dict(module_m=5e-3, teeth_pinion=29, teeth_wheel=88, face_width_m=0.06)
     kw[key] = value
-    with pytest.raises(ScenarioError, match=rf"^{key} = .*allowed"):
+    with pytest.raises(GearGeometryError, match=rf"^{key} = .*allowed"):
         gear_pair_geometry(**kw)

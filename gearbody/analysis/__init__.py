@@ -26,18 +26,10 @@ from gearbody.analysis.indicators import (
     rms,
     sideband_energy_ratio,
 )
-from gearbody.analysis.labels import (
-    GearMesh,
-    KinematicSources,
-    LabelledPeak,
-    Psd,
-    Shaft,
-    kinematic_lines,
-    label_peaks,
-    peaks_table,
-    peaks_to_rows,
-    power_spectral_density,
-)
+from gearbody.analysis.kinematics import GearMesh, KinematicLine, KinematicSources, Shaft, kinematic_lines
+from gearbody.analysis.peak_report import peaks_table, peaks_to_rows, plot_labelled_spectrum
+from gearbody.analysis.peaks import LabelledPeak, label_peaks
+from gearbody.analysis.psd import Psd, power_spectral_density
 from gearbody.analysis.spectrum import (
     Peak,
     SidebandLine,
@@ -52,6 +44,7 @@ from gearbody.analysis.tsa import AngleDomainSignal, SynchronousAverage, angle_r
 
 __all__ = [
     "GearMesh",
+    "KinematicLine",
     "KinematicSources",
     "LabelledPeak",
     "Psd",
@@ -60,6 +53,7 @@ __all__ = [
     "label_peaks",
     "peaks_table",
     "peaks_to_rows",
+    "plot_labelled_spectrum",
     "power_spectral_density",
     "AngleDomainSignal",
     "ConditionIndicators",

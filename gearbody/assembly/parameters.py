@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from ..model import Scenario
-from ..physics.errors import tooth_error_depths_m
+from ..physics.error_mode import tooth_error_depths_m
 from ..physics.mesh import pack_mesh_parameters
 from ..physics.mesh_stiffness import stage_pair_table
 

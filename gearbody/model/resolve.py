@@ -26,6 +26,7 @@ def _agree(where: str, key: str, given, computed: float) -> float:
 
 def pair_geometry(mesh, teeth_pinion: int, teeth_wheel: int, where: str = "design.mesh."):
     """:class:`~gearbody.physics.gear_geometry.GearPairGeometry` of a mesh's [geometry] table."""
+    from ..physics.exceptions import GearGeometryError
     from ..physics.gear_geometry import gear_pair_geometry
 
     g = mesh.geometry
@@ -43,7 +44,7 @@ def pair_geometry(mesh, teeth_pinion: int, teeth_wheel: int, where: str = "desig
             dedendum_coefficient=g.dedendum_coefficient,
             centre_distance_m=None if g.centre_distance_mm is None else g.centre_distance_mm * 1e-3,
         )
-    except ScenarioError as exc:
+    except GearGeometryError as exc:
         raise ScenarioError(f"{where}geometry: {exc}") from None
 
 
@@ -138,11 +139,15 @@ def resolve_stage_geometry(pinion, wheel, mesh, where: str):
 def resolve_iso_stiffness(mesh, teeth_pinion: int, teeth_wheel: int, rated_force_N: float, where: str):
     """Mesh with the ISO 6336-1 method B single/double stiffness; line load F_t / b with the rated
     tangential force at the reference circle, F_t = F_rated cos(alpha_t) (F_rated: line of action)."""
+    from ..physics.exceptions import GearGeometryError
     from ..physics.stiffness_iso import iso_mesh_stiffness_profile
 
     geo = pair_geometry(mesh, teeth_pinion, teeth_wheel, where)
     line_load = rated_force_N * math.cos(geo.transverse_pressure_angle_rad) / mesh.geometry.face_width_mm
-    single, double = iso_mesh_stiffness_profile(geo, line_load_N_per_mm=line_load)
+    try:
+        single, double = iso_mesh_stiffness_profile(geo, line_load_N_per_mm=line_load)
+    except GearGeometryError as exc:
+        raise ScenarioError(str(exc)) from None
     return dataclasses.replace(
         mesh,
         stiffness_single_N_per_m=_agree(

@@ -1,7 +1,7 @@
 """Engine-free physics: mesh force law, error modes, motor characteristic, operating profiles."""
 
 from . import _numba_cache  # noqa: F401  (first: drops stale compiled kernels before any is loaded)
-from .errors import tooth_error_depths_m, tooth_random_factors
+from .error_mode import tooth_error_depths_m, tooth_random_factors
 from .mesh import (
     error_shape,
     mean_stiffness_N_per_m,

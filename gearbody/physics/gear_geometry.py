@@ -17,8 +17,8 @@ Equations (gear k = 1 pinion, 2 wheel; h_a*, h_f* addendum/dedendum coefficients
   ``cos(alpha_wt) = a cos(alpha_t) / a_w``
   and it must agree with the shifts within ``centre_distance_tolerance_m`` (default 0.005 m_n); the
   difference is the design's centre-distance backlash, ``k = (a_w - a)/m_n - (x1 + x2)``;
-- transverse base pitch ``p_bt = pi m_t cos(alpha_t)``; line of action ``T1T2 = a_w sin(alpha_wt)``;
-  points measured from T1 (tangent point on the pinion base circle):
+- transverse base pitch ``p_bt = pi m_t cos(alpha_t) = 2 pi r_b1 / z1``; line of action
+  ``T1T2 = a_w sin(alpha_wt)``; points measured from T1 (tangent point on the pinion base circle):
   ``E = sqrt(r_a1² - r_b1²)`` (pinion tip, end of contact), ``A = T1T2 - sqrt(r_a2² - r_b2²)``
   (wheel tip, start of contact), ``C = r_b1 tan(alpha_wt)``, ``B = E - p_bt``, ``D = A + p_bt``;
 - ``eps_alpha = (E - A) / p_bt`` (= g_alpha / p_bt), ``eps_beta = b sin(beta) / (pi m_n)``,
@@ -29,170 +29,57 @@ Equations (gear k = 1 pinion, 2 wheel; h_a*, h_f* addendum/dedendum coefficients
 - normal tip thickness ``s_an = s_at cos(beta_a)``,
   ``s_at = d_a [(pi + 4 x tan(alpha_n)) / (2 z) + inv(alpha_t) - inv(alpha_at)]``,
   ``cos(alpha_at) = r_b / r_a``, ``tan(beta_a) = tan(beta) r_a / r``;
-- backlash (Niemann & Winter; ISO/TR 10064-2): base normal backlash
-  ``j_bn = -(E_sn1 + E_sn2) cos(alpha_n) + 2 Delta_a sin(alpha_wt) cos(beta_b)``
-  (E_sn: normal tooth-thickness allowance, negative = thinner; Delta_a: centre-distance deviation;
-  uses cos(alpha_t) cos(beta_b) / cos(beta) = cos(alpha_n)); along the transverse line of action
-  ``j_bt = j_bn / cos(beta_b)``; gearbody's eq. (4) half-width ``l_u = j_bt / 2`` (= j_bn / 2 for spur).
+- backlash: :mod:`.gear_backlash`.
 
-Checks (:class:`GearGeometryError`, a :class:`~gearbody.model.params.ScenarioError`, naming parameter,
-value and allowed range): positive inputs, undercut, centre distance vs shifts, tip thickness
-``s_an >= 0.2 m_n``, tip-root clearance ``>= 0``, interference (contact start before T1 or end beyond T2,
-or into the non-involute root below rho_F), ``eps_alpha >= 1``.
+Arithmetic (kept to the last bit, the potential-energy pair table depends on it): spur gears take
+``m_t = m_n`` and ``alpha_t = alpha_n`` as they are; shifts summing to zero give ``alpha_wt = alpha_t``
+exactly, other shifts the root of the involute equation (no ``acos`` round trip); ``p_bt = 2 pi r_b1 / z1``.
 
-Mesh-phase convention of gearbody (docs/scenario.md; :func:`gearbody.physics.mesh.stiffness_at_phase`):
-one mesh period is one transverse base pitch of travel along the line of action; the pair assigned to a
-period passes the middle of the single-contact zone, ``(B + D)/2 = (A + E)/2``, at p = 0.5, so its contact
-runs over ``-h <= p < 1 + h`` with ``h = (eps_alpha - 1)/2``; contact point
-``s(p) = (A + E)/2 + (p - 0.5) p_bt``.
-Friction arms are the radii of curvature of the flanks at the contact point (the distance to each
-gear's base tangent point, not to the pitch point): ``rho_1 = s``, ``rho_2 = T1T2 - s``; at the pitch point
-``rho_1 = r_b1 tan(alpha_wt)``, as in mesh.py.
+Checks (:class:`~gearbody.physics.exceptions.GearGeometryError`, a ``ValueError`` that the model turns
+into a ``ScenarioError``, naming parameter, value and allowed range): positive inputs, undercut, centre
+distance vs shifts, tip thickness ``s_an >= 0.2 m_n``, tip-root clearance ``>= 0``, interference (contact
+start before T1 or end beyond T2, or into the non-involute root below rho_F), ``eps_alpha >= 1``.
+
+Module map: :mod:`.involute` (involute function, radii and tip thickness of one gear),
+:mod:`.gear_pair` (the result, :class:`GearPairGeometry`, and the mesh-phase convention),
+:mod:`.gear_backlash` (backlash); this module builds the pair and checks it, and re-exports the others'
+public names.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
-import numpy as np
-from scipy.optimize import brentq
-
-from gearbody.model.params import ScenarioError
+from .exceptions import GearGeometryError, geometry_error
+from .gear_backlash import backlash_half_width_m, backlash_range_m, normal_backlash_m
+from .gear_pair import GearPairGeometry
+from .involute import (
+    GearRadii,
+    gear_radii,
+    inverse_involute,
+    involute,
+    normal_tip_thickness_m,
+    pitch_base_root_radii_m,
+    tip_radius_m,
+    transverse_module_and_pressure_angle,
+)
 
 MIN_TIP_THICKNESS_MODULES = 0.2  # s_an >= 0.2 m_n (common design limit; 0.2-0.4 m_n)
 CENTRE_DISTANCE_TOLERANCE_MODULES = 0.005  # |a_w - a_w(x1 + x2)| <= 0.005 m_n unless told otherwise
 
-
-class GearGeometryError(ScenarioError):
-    """Impossible or unsound gear-pair geometry; the message names parameter, value and allowed range."""
-
-
-def _fail(name: str, value: float, reason: str, allowed: str) -> GearGeometryError:
-    shown = f"{value:.6g}" if isinstance(value, float) else repr(value)
-    return GearGeometryError(f"{name} = {shown}: {reason}; allowed: {allowed}")
-
-
-def involute(angle_rad: float) -> float:
-    """Involute function inv(a) = tan(a) - a."""
-    return math.tan(angle_rad) - angle_rad
-
-
-def inverse_involute(value: float) -> float:
-    """Angle a in (0, pi/2) with inv(a) = value (value > 0)."""
-    if value <= 0.0:
-        raise ValueError(f"inverse_involute: value = {value:g} must be > 0")
-    return brentq(lambda a: involute(a) - value, 1e-9, 0.5 * math.pi - 1e-9, xtol=1e-15, rtol=1e-15)
-
-
-@dataclasses.dataclass(frozen=True)
-class GearPairGeometry:
-    """Geometry of an external involute gear pair (pinion = gear 1); build it with :func:`gear_pair_geometry`.
-
-    Positions on the line of action (``*_position_m``) are distances from T1, the tangent point on the
-    pinion base circle, towards T2.
-    """
-
-    module_m: float  # normal module m_n
-    teeth_pinion: int
-    teeth_wheel: int
-    face_width_m: float
-    pressure_angle_rad: float  # normal pressure angle alpha_n
-    helix_angle_rad: float  # |beta| at the reference cylinder
-    profile_shift_pinion: float
-    profile_shift_wheel: float
-    addendum_coefficient: float
-    dedendum_coefficient: float
-    transverse_module_m: float
-    transverse_pressure_angle_rad: float  # alpha_t
-    base_helix_angle_rad: float  # beta_b
-    working_pressure_angle_rad: float  # alpha_wt, transverse
-    reference_centre_distance_m: float  # a = r1 + r2
-    centre_distance_m: float  # working a_w
-    tip_alteration_coefficient: float  # k = (a_w - a)/m_n - (x1 + x2)
-    pitch_radius_pinion_m: float
-    pitch_radius_wheel_m: float
-    base_radius_pinion_m: float
-    base_radius_wheel_m: float
-    tip_radius_pinion_m: float
-    tip_radius_wheel_m: float
-    root_radius_pinion_m: float
-    root_radius_wheel_m: float
-    tip_thickness_pinion_m: float  # normal, s_an
-    tip_thickness_wheel_m: float
-    transverse_base_pitch_m: float  # p_bt
-    line_of_action_length_m: float  # T1T2
-    contact_start_position_m: float  # A
-    single_start_position_m: float  # B
-    pitch_point_position_m: float  # C
-    single_end_position_m: float  # D
-    contact_end_position_m: float  # E
-    transverse_contact_ratio: float  # eps_alpha
-    overlap_ratio: float  # eps_beta
-
-    @property
-    def total_contact_ratio(self) -> float:
-        """eps_gamma = eps_alpha + eps_beta."""
-        return self.transverse_contact_ratio + self.overlap_ratio
-
-    @property
-    def working_pitch_radius_pinion_m(self) -> float:
-        """r_w1 = r_b1 / cos(alpha_wt)."""
-        return self.base_radius_pinion_m / math.cos(self.working_pressure_angle_rad)
-
-    @property
-    def working_pitch_radius_wheel_m(self) -> float:
-        """r_w2 = r_b2 / cos(alpha_wt)."""
-        return self.base_radius_wheel_m / math.cos(self.working_pressure_angle_rad)
-
-    @property
-    def path_of_contact_m(self) -> float:
-        """g_alpha = E - A."""
-        return self.contact_end_position_m - self.contact_start_position_m
-
-    @property
-    def half_double_contact(self) -> float:
-        """h = (eps_alpha - 1)/2: double contact for p < h or p >= 1 - h (when eps_alpha < 2)."""
-        return 0.5 * (self.transverse_contact_ratio - 1.0)
-
-    @property
-    def pitch_point_phase(self) -> float:
-        """Mesh phase at which the period's pair passes the pitch point C (0.5 + (C - (A+E)/2)/p_bt).
-
-        May lie outside [0, 1) for strongly unequal addendum paths; gearbody's scenario needs [0, 1].
-        """
-        return self.phase_at_position(self.pitch_point_position_m)
-
-    def position_on_line_of_action_m(self, phase: float | np.ndarray) -> float | np.ndarray:
-        """Contact point of the period's pair at mesh phase p, distance from T1: (A+E)/2 + (p - 0.5) p_bt."""
-        mid = 0.5 * (self.contact_start_position_m + self.contact_end_position_m)
-        return mid + (phase - 0.5) * self.transverse_base_pitch_m
-
-    def phase_at_position(self, position_m: float | np.ndarray) -> float | np.ndarray:
-        """Inverse of :meth:`position_on_line_of_action_m`."""
-        mid = 0.5 * (self.contact_start_position_m + self.contact_end_position_m)
-        return 0.5 + (position_m - mid) / self.transverse_base_pitch_m
-
-    def pairs_in_contact(self, phase: float) -> tuple[tuple[int, float], ...]:
-        """Tooth pairs in contact at mesh phase p in [0, 1): ``(offset, position_m)`` per pair, by offset.
-
-        Offset 0 is the period's pair, -1 the previous (outgoing, at its own phase p + 1), +1 the next
-        (incoming, at p - 1), and so on. A pair is in contact over ``-h <= own phase < 1 + h``; the bounds
-        are written as in ``stiffness_at_phase`` (previous pair: ``p < h``; next pair: ``p >= 1 - h``).
-        """
-        h = self.half_double_contact
-        reach = math.ceil(h) + 1
-        pairs = []
-        for k in range(-reach, reach + 1):
-            if k - h <= phase < (k + 1) + h:
-                pairs.append((k, float(self.position_on_line_of_action_m(phase - k))))
-        return tuple(pairs)
-
-    def friction_arms_m(
-        self, position_m: float | np.ndarray
-    ) -> tuple[float | np.ndarray, float | np.ndarray]:
-        """Friction arms (rho_1, rho_2) at a contact position s from T1: (s, T1T2 - s), m."""
-        return position_m, self.line_of_action_length_m - position_m
+__all__ = [
+    "GearGeometryError",
+    "GearPairGeometry",
+    "GearRadii",
+    "backlash_half_width_m",
+    "backlash_range_m",
+    "gear_pair_geometry",
+    "gear_radii",
+    "inverse_involute",
+    "involute",
+    "normal_backlash_m",
+    "transverse_module_and_pressure_angle",
+]
 
 
 def gear_pair_geometry(
@@ -234,34 +121,36 @@ def gear_pair_geometry(
     mn, z1, z2 = module_m, int(teeth_pinion), int(teeth_wheel)
     x1, x2, ha, hf = profile_shift_pinion, profile_shift_wheel, addendum_coefficient, dedendum_coefficient
     alpha_n, beta = math.radians(pressure_angle_deg), abs(math.radians(helix_angle_deg))
-    mt = mn / math.cos(beta)
-    alpha_t = math.atan(math.tan(alpha_n) / math.cos(beta))
+    mt, alpha_t = transverse_module_and_pressure_angle(mn, alpha_n, beta)
     beta_b = math.atan(math.tan(beta) * math.cos(alpha_t))
-    r1, r2 = 0.5 * z1 * mt, 0.5 * z2 * mt
-    rb1, rb2 = r1 * math.cos(alpha_t), r2 * math.cos(alpha_t)
+    r1, rb1, rf1 = pitch_base_root_radii_m(z1, x1, mn, mt, alpha_t, hf)
+    r2, rb2, rf2 = pitch_base_root_radii_m(z2, x2, mn, mt, alpha_t, hf)
 
     for name, z, x in (("teeth_pinion", z1, x1), ("teeth_wheel", z2, x2)):
         z_min = 2.0 * (ha - x) * math.cos(beta) / math.sin(alpha_t) ** 2
         if z < z_min:
             shift = "profile_shift_pinion" if name == "teeth_pinion" else "profile_shift_wheel"
             x_min = ha - z * math.sin(alpha_t) ** 2 / (2.0 * math.cos(beta))
-            raise _fail(
+            raise geometry_error(
                 name, z, f"undercut with {shift} = {x:g}", f">= {z_min:.4g} teeth, or {shift} >= {x_min:.4g}"
             )
 
     a = r1 + r2
-    inv_wt = involute(alpha_t) + 2.0 * math.tan(alpha_n) * (x1 + x2) / (z1 + z2)
+    inv_t = involute(alpha_t)
+    inv_wt = inv_t + 2.0 * math.tan(alpha_n) * (x1 + x2) / (z1 + z2)
     if inv_wt <= 0.0:
         x_lim = -involute(alpha_t) * (z1 + z2) / (2.0 * math.tan(alpha_n))
-        raise _fail(
+        raise geometry_error(
             "profile_shift_pinion + profile_shift_wheel",
             x1 + x2,
             "no working pressure angle",
             f"> {x_lim:.4g}",
         )
-    a_w_shifts = a * math.cos(alpha_t) / math.cos(inverse_involute(inv_wt))
+    # shifts summing to (about) zero: alpha_wt = alpha_t exactly, not the solver's approximation
+    alpha_wt_shifts = alpha_t if abs(inv_wt - inv_t) < 1e-15 else inverse_involute(inv_wt)
+    a_w_shifts = a * math.cos(alpha_t) / math.cos(alpha_wt_shifts)
     if centre_distance_m is None:
-        a_w = a_w_shifts
+        a_w, alpha_wt = a_w_shifts, alpha_wt_shifts
     else:
         tol = (
             CENTRE_DISTANCE_TOLERANCE_MODULES * mn
@@ -269,7 +158,7 @@ def gear_pair_geometry(
             else centre_distance_tolerance_m
         )
         if abs(centre_distance_m - a_w_shifts) > tol:
-            raise _fail(
+            raise geometry_error(
                 "centre_distance_m",
                 float(centre_distance_m),
                 f"does not match the profile shifts x1 + x2 = {x1 + x2:g} "
@@ -277,29 +166,28 @@ def gear_pair_geometry(
                 f"[{a_w_shifts - tol:.6g}, {a_w_shifts + tol:.6g}] m",
             )
         if centre_distance_m <= a * math.cos(alpha_t):
-            raise _fail(
+            raise geometry_error(
                 "centre_distance_m",
                 float(centre_distance_m),
                 "below the base-circle sum",
                 f"> {a * math.cos(alpha_t):.6g} m",
             )
         a_w = float(centre_distance_m)
-    alpha_wt = math.acos(a * math.cos(alpha_t) / a_w)
+        alpha_wt = math.acos(a * math.cos(alpha_t) / a_w)
     k = (a_w - a) / mn - (x1 + x2)
 
     if tip_diameters_m is not None:
         ra1, ra2 = 0.5 * tip_diameters_m[0], 0.5 * tip_diameters_m[1]
         for name, ra, r in (("tip_diameters_m[0]", ra1, r1), ("tip_diameters_m[1]", ra2, r2)):
             if not ra > r:
-                raise _fail(
+                raise geometry_error(
                     name, 2.0 * ra, "tip diameter not above the reference diameter", f"> {2.0 * r:.6g} m"
                 )
     else:
         shortening = k if (tip_shortening and k < 0.0) else 0.0
-        ra1, ra2 = r1 + mn * (ha + x1 + shortening), r2 + mn * (ha + x2 + shortening)
-    rf1, rf2 = r1 - mn * (hf - x1), r2 - mn * (hf - x2)
+        ra1, ra2 = tip_radius_m(r1, x1, mn, ha, shortening), tip_radius_m(r2, x2, mn, ha, shortening)
 
-    pbt = math.pi * mt * math.cos(alpha_t)
+    pbt = 2.0 * math.pi * rb1 / z1  # = pi m_t cos(alpha_t)
     t1t2 = a_w * math.sin(alpha_wt)
     s_e = math.sqrt(ra1**2 - rb1**2)
     s_a = t1t2 - math.sqrt(ra2**2 - rb2**2)
@@ -307,21 +195,21 @@ def gear_pair_geometry(
     rho_f1 = r1 * math.sin(alpha_t) - (ha - x1) * mn / math.sin(alpha_t)
     rho_f2 = r2 * math.sin(alpha_t) - (ha - x2) * mn / math.sin(alpha_t)
     if s_a < 0.0:
-        raise _fail(
+        raise geometry_error(
             "tip_radius_wheel_m",
             ra2,
             "contact starts before T1 (interference below the pinion base circle)",
             f"<= {math.hypot(t1t2, rb2):.6g} m",
         )
     if s_e > t1t2:
-        raise _fail(
+        raise geometry_error(
             "tip_radius_pinion_m",
             ra1,
             "contact ends beyond T2 (interference below the wheel base circle)",
             f"<= {math.hypot(t1t2, rb1):.6g} m",
         )
-    san1 = _normal_tip_thickness_m(z1, x1, r1, rb1, ra1, alpha_n, alpha_t, beta)
-    san2 = _normal_tip_thickness_m(z2, x2, r2, rb2, ra2, alpha_n, alpha_t, beta)
+    san1 = normal_tip_thickness_m(z1, x1, r1, rb1, ra1, alpha_n, alpha_t, beta)
+    san2 = normal_tip_thickness_m(z2, x2, r2, rb2, ra2, alpha_n, alpha_t, beta)
     s_min = MIN_TIP_THICKNESS_MODULES * mn
     for i, (name, san, x) in enumerate(
         (("profile_shift_pinion", san1, x1), ("profile_shift_wheel", san2, x2))
@@ -329,7 +217,7 @@ def gear_pair_geometry(
         if san < s_min:
             if tip_diameters_m is not None:
                 name, x = f"tip_diameters_m[{i}]", float(tip_diameters_m[i])
-            raise _fail(
+            raise geometry_error(
                 name,
                 x,
                 f"tip too thin, normal tip thickness {san:.4g} m",
@@ -337,7 +225,7 @@ def gear_pair_geometry(
             )
     for name, clearance in (("tip_radius_pinion", a_w - ra1 - rf2), ("tip_radius_wheel", a_w - ra2 - rf1)):
         if clearance < 0.0:
-            raise _fail(
+            raise geometry_error(
                 "centre_distance_m",
                 a_w,
                 f"{name} reaches {-clearance:.4g} m into the mating root (try tip_shortening=True)",
@@ -346,7 +234,7 @@ def gear_pair_geometry(
 
     if s_a < rho_f1:
         limit = math.hypot(t1t2 - rho_f1, rb2)
-        raise _fail(
+        raise geometry_error(
             "tip_radius_wheel_m",
             ra2,
             "contact starts below the generated involute of the pinion (root interference)",
@@ -354,7 +242,7 @@ def gear_pair_geometry(
         )
     if t1t2 - s_e < rho_f2:
         limit = math.hypot(t1t2 - rho_f2, rb1)
-        raise _fail(
+        raise geometry_error(
             "tip_radius_pinion_m",
             ra1,
             "contact ends below the generated involute of the wheel (root interference)",
@@ -362,7 +250,9 @@ def gear_pair_geometry(
         )
     eps_alpha = (s_e - s_a) / pbt
     if eps_alpha < 1.0:
-        raise _fail("transverse_contact_ratio", eps_alpha, "less than one pair always in contact", ">= 1")
+        raise geometry_error(
+            "transverse_contact_ratio", eps_alpha, "less than one pair always in contact", ">= 1"
+        )
 
     return GearPairGeometry(
         module_m=mn,
@@ -404,33 +294,24 @@ def gear_pair_geometry(
     )
 
 
-def _normal_tip_thickness_m(z, x, r, rb, ra, alpha_n, alpha_t, beta) -> float:
-    alpha_at = math.acos(rb / ra)
-    s_at = (
-        2.0
-        * ra
-        * ((math.pi + 4.0 * x * math.tan(alpha_n)) / (2.0 * z) + involute(alpha_t) - involute(alpha_at))
-    )
-    beta_a = math.atan(math.tan(beta) * ra / r)
-    return s_at * math.cos(beta_a)
-
-
 def _check_inputs(mn, z1, z2, b, alpha_deg, beta_deg, ha, hf, shifts, a_w) -> None:
     if not (isinstance(mn, (int, float)) and mn > 0.0 and math.isfinite(mn)):
-        raise _fail("module_m", mn, "module must be positive", "> 0 m")
+        raise geometry_error("module_m", mn, "module must be positive", "> 0 m")
     for name, z in (("teeth_pinion", z1), ("teeth_wheel", z2)):
         if isinstance(z, bool) or int(z) != z or z < 5:
-            raise _fail(name, z, "tooth count must be a whole number of at least 5", "integer >= 5")
+            raise geometry_error(name, z, "tooth count must be a whole number of at least 5", "integer >= 5")
     if not b > 0.0:
-        raise _fail("face_width_m", b, "face width must be positive", "> 0 m")
+        raise geometry_error("face_width_m", b, "face width must be positive", "> 0 m")
     if not 0.0 < alpha_deg < 45.0:
-        raise _fail("pressure_angle_deg", alpha_deg, "normal pressure angle out of range", "> 0 and < 45")
+        raise geometry_error(
+            "pressure_angle_deg", alpha_deg, "normal pressure angle out of range", "> 0 and < 45"
+        )
     if not -45.0 < beta_deg < 45.0:
-        raise _fail("helix_angle_deg", beta_deg, "helix angle out of range", "> -45 and < 45")
+        raise geometry_error("helix_angle_deg", beta_deg, "helix angle out of range", "> -45 and < 45")
     if not ha > 0.0:
-        raise _fail("addendum_coefficient", ha, "addendum must be positive", "> 0")
+        raise geometry_error("addendum_coefficient", ha, "addendum must be positive", "> 0")
     if not hf >= ha:
-        raise _fail(
+        raise geometry_error(
             "dedendum_coefficient",
             hf,
             "dedendum below the addendum (negative bottom clearance)",
@@ -438,72 +319,6 @@ def _check_inputs(mn, z1, z2, b, alpha_deg, beta_deg, ha, hf, shifts, a_w) -> No
         )
     for name, x in zip(("profile_shift_pinion", "profile_shift_wheel"), shifts, strict=True):
         if not math.isfinite(x):
-            raise _fail(name, x, "profile shift must be finite", "finite")
+            raise geometry_error(name, x, "profile shift must be finite", "finite")
     if a_w is not None and not a_w > 0.0:
-        raise _fail("centre_distance_m", a_w, "centre distance must be positive", "> 0 m")
-
-
-def normal_backlash_m(
-    geometry: GearPairGeometry,
-    *,
-    thickness_allowance_pinion_m: float,
-    thickness_allowance_wheel_m: float,
-    centre_distance_deviation_m: float = 0.0,
-) -> float:
-    """Base normal backlash j_bn = -(E_sn1 + E_sn2) cos(alpha_n) + 2 Delta_a sin(alpha_wt) cos(beta_b), m.
-
-    E_sn: normal tooth-thickness allowances (negative = thinner teeth); Delta_a: deviation of the actual
-    from the nominal centre distance. Niemann & Winter, ISO/TR 10064-2 (first order in the deviations).
-    """
-    return -(thickness_allowance_pinion_m + thickness_allowance_wheel_m) * math.cos(
-        geometry.pressure_angle_rad
-    ) + 2.0 * centre_distance_deviation_m * math.sin(geometry.working_pressure_angle_rad) * math.cos(
-        geometry.base_helix_angle_rad
-    )
-
-
-def backlash_half_width_m(geometry: GearPairGeometry, normal_backlash: float) -> float:
-    """gearbody's l_u (``backlash_um`` * 1e-6): half the backlash along the transverse line of action,
-    j_bn / (2 cos(beta_b)) (= j_bn / 2 for spur gears)."""
-    return 0.5 * normal_backlash / math.cos(geometry.base_helix_angle_rad)
-
-
-def backlash_range_m(
-    geometry: GearPairGeometry,
-    *,
-    thickness_allowances_pinion_m: tuple[float, float],
-    thickness_allowances_wheel_m: tuple[float, float],
-    centre_distance_allowances_m: tuple[float, float] = (0.0, 0.0),
-) -> tuple[float, float]:
-    """(j_bn_min, j_bn_max), m, from (upper, lower) allowances E_sns, E_sni of each gear and (upper, lower)
-    centre-distance allowances. The least backlash (upper thickness allowances, lower centre distance)
-    must be >= 0, else the teeth jam."""
-    for name, (upper, lower) in (
-        ("thickness_allowances_pinion_m", thickness_allowances_pinion_m),
-        ("thickness_allowances_wheel_m", thickness_allowances_wheel_m),
-        ("centre_distance_allowances_m", centre_distance_allowances_m),
-    ):
-        if upper < lower:
-            raise _fail(
-                name,
-                (upper, lower),
-                "upper allowance below the lower one",
-                "(upper, lower) with upper >= lower",
-            )
-    j_min = normal_backlash_m(
-        geometry,
-        thickness_allowance_pinion_m=thickness_allowances_pinion_m[0],
-        thickness_allowance_wheel_m=thickness_allowances_wheel_m[0],
-        centre_distance_deviation_m=centre_distance_allowances_m[1],
-    )
-    j_max = normal_backlash_m(
-        geometry,
-        thickness_allowance_pinion_m=thickness_allowances_pinion_m[1],
-        thickness_allowance_wheel_m=thickness_allowances_wheel_m[1],
-        centre_distance_deviation_m=centre_distance_allowances_m[0],
-    )
-    if j_min < 0.0:
-        raise _fail(
-            "normal_backlash_min_m", j_min, "the teeth jam at the upper thickness allowances", ">= 0 m"
-        )
-    return j_min, j_max
+        raise geometry_error("centre_distance_m", a_w, "centre distance must be positive", "> 0 m")

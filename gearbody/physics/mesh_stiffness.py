@@ -125,7 +125,7 @@ def pair_stiffness_table(
 ) -> PairStiffnessTable:
     """The pair table of a scenario mesh geometry (cached; arguments are frozen scenario objects)."""
     pair = spur_pair(geometry, teeth_pinion, teeth_wheel)
-    h = 0.5 * (pair.contact_ratio - 1.0)
+    h = pair.geometry.half_double_contact
     q = np.linspace(-h, 1.0 + h, geometry.table_points)
     s = pair.roll_position_m(q)
     # the grid's ends lie on the contact limits; clamp round-off so that both count as in contact

@@ -34,7 +34,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from .gear_geometry import GearGeometryError, GearPairGeometry
+from .exceptions import GearGeometryError
+from .gear_geometry import GearPairGeometry
 
 Q_COEFFICIENTS = (0.04723, 0.15551, 0.25791, -0.00635, -0.11654, -0.00193, -0.24188, 0.00529, 0.00182)
 THEORETICAL_CORRECTION_C_M = 0.8
