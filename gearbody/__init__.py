@@ -4,8 +4,6 @@ After W. Bartelmus, *Mathematical modelling and computer simulations as an aid t
 diagnostics*, Mechanical Systems and Signal Processing 15(5), 2001.
 """
 
-from .version import __version__
-
 from .errors import GearbodyError, InputError, ScenarioError, SimulationError  # noqa: E402
 from .model import (  # noqa: E402
     Operation,
@@ -18,6 +16,7 @@ from .model import (  # noqa: E402
     steady,
 )
 from .result import Result  # noqa: E402
+from .version import __version__
 
 
 def simulate(scenario, *, progress: bool = False) -> Result:

@@ -17,7 +17,6 @@ import exudyn.solver
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
-from ..version import __version__
 from ..analysis.antialias import band_limited_samples
 from ..assembly import (
     gear_names,
@@ -35,6 +34,7 @@ from ..physics.bearings import LinearBearing
 from ..physics.lateral import mesh_directions
 from ..physics.mesh import mesh_contact_series, mesh_phase_series
 from ..result import Result
+from ..version import __version__
 from .build import BuiltSystem, build_muller, build_torsional
 from .sampling import OVERSAMPLING, is_band_limited, mesh_jump_times
 

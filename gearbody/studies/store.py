@@ -15,8 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from gearbody.version import __version__
 from gearbody.model import Scenario, dump_scenario
+from gearbody.version import __version__
 
 from .parse import SweepSpecError
 from .spec import Case, Study
