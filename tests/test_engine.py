@@ -6,21 +6,15 @@ import pytest
 import gearbody as gb
 from gearbody.engine import simulate
 from gearbody.errors import InputError
-from gearbody.model import load_scenario
-
-STEADY = [
-    'operation.initial_state="steady"',
-    "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
-    "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
-]
 
 
-def steady(scene, *extra, t_end=0.05):
-    return load_scenario(scene, [*STEADY, f"operation.t_end_s={t_end}", *extra])
+@pytest.fixture
+def steady(steady_scenario):
+    return steady_scenario
 
 
 @pytest.mark.parametrize("scene", ["muller", "two-wheel", "one-stage"])
-def test_static_equilibrium_holds_without_excitation(scene):
+def test_static_equilibrium_holds_without_excitation(scene, steady):
     """Constant stiffness, no error, no friction, steady start: the mesh force stays at F_rated."""
     sc = steady(
         scene,
@@ -32,7 +26,7 @@ def test_static_equilibrium_holds_without_excitation(scene):
     assert np.max(np.abs(r.kd - 1.0)) < 2e-3
 
 
-def test_steady_running_transmits_rated_force_on_average():
+def test_steady_running_transmits_rated_force_on_average(steady):
     sc = steady("one-stage", t_end=0.2)
     r = simulate(sc)
     f_mesh = np.mean(r["mesh_frequency_hz"])
@@ -42,7 +36,7 @@ def test_steady_running_transmits_rated_force_on_average():
     assert f_mesh == pytest.approx(29 * 107.0 / (2 * np.pi), rel=2e-3)  # the seed's rated speed
 
 
-def test_result_has_fixed_output_grid_signals_and_metadata(tmp_path):
+def test_result_has_fixed_output_grid_signals_and_metadata(tmp_path, steady):
     sc = steady("one-stage")
     r = gb.simulate(sc)
     rate = sc.solver.output_rate_hz
@@ -77,7 +71,7 @@ def test_result_has_fixed_output_grid_signals_and_metadata(tmp_path):
         assert {"time", "mesh_force_N"} <= set(z.files)
 
 
-def test_same_seed_same_run_other_seed_other_teeth():
+def test_same_seed_same_run_other_seed_other_teeth(steady):
     a = simulate(steady("two-wheel", "production.error_mode.r=0.8"))
     b = simulate(steady("two-wheel", "production.error_mode.r=0.8"))
     c = simulate(steady("two-wheel", "production.error_mode.r=0.8", "meta.seed=2"))
@@ -85,24 +79,24 @@ def test_same_seed_same_run_other_seed_other_teeth():
     assert not np.allclose(a.mesh_force, c.mesh_force)
 
 
-def test_muller_pitch_line_is_kinematic():
+def test_muller_pitch_line_is_kinematic(steady):
     """Muller: the mesh phase follows the prescribed speed, whatever the mass does."""
     r = simulate(steady("muller"))
     assert np.allclose(r["pinion_angle_rad"], r.time_s * 108.63)
 
 
-def test_motor_that_cannot_carry_the_load_is_reported_before_running():
+def test_motor_that_cannot_carry_the_load_is_reported_before_running(steady):
     with pytest.raises(InputError, match="breakdown torque"):  # an input error (exit 2), not numerical
         simulate(steady("one-stage", "design.machine.rated_torque_Nm=6000"))
 
 
-def test_steady_start_on_a_broken_tooth_is_refused_with_a_hint():
+def test_steady_start_on_a_broken_tooth_is_refused_with_a_hint(steady):
     with pytest.raises(InputError, match="carry no load"):
         broken = 'condition.damaged_teeth=[{gear="pinion",tooth=0,stiffness_factor=0.0}]'
         simulate(steady("one-stage", broken))
 
 
-def test_steady_start_subtracts_the_error_in_mesh():
+def test_steady_start_subtracts_the_error_in_mesh(steady):
     """a = 0 puts the full error at p = 0: the steady start must still be an equilibrium."""
     sc = steady(
         "one-stage",

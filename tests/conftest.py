@@ -1,0 +1,38 @@
+"""Shared fixtures, and the ``slow`` marker: ``pytest -m "not slow"`` is the fast loop (every unit test,
+under a minute on two cores); plain ``pytest`` (CI) runs everything, the simulation-heavy comparisons with
+the independent reference included."""
+
+from __future__ import annotations
+
+import pytest
+
+from gearbody.model import Scenario, load_scenario
+
+STEADY_OVERRIDES = (
+    'operation.initial_state="steady"',
+    "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
+    "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
+)
+"""Steady rated running from the steady operating point (no run-up)."""
+
+
+@pytest.fixture
+def steady_overrides() -> list[str]:
+    """The overrides of steady rated running (a fresh list per test)."""
+    return list(STEADY_OVERRIDES)
+
+
+@pytest.fixture
+def steady_scenario():
+    """``steady_scenario(scene, *overrides, t_end=0.05)``: a scene in steady rated running."""
+
+    def make(scene: str, *extra: str, t_end: float = 0.05) -> Scenario:
+        return load_scenario(scene, [*STEADY_OVERRIDES, f"operation.t_end_s={t_end}", *extra])
+
+    return make
+
+
+@pytest.fixture(scope="session")
+def two_stage() -> Scenario:
+    """The two-stage scene as shipped (immutable, so shared by the session)."""
+    return load_scenario("two-stage")
