@@ -45,8 +45,16 @@ from ..assembly import (
 from ..model import Scenario
 from ..physics import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
-from ..physics.lateral import lateral_mesh_forces, tangent_stiffness_N_per_m
+from ..physics.lateral import tangent_stiffness_N_per_m
 from ..physics.mesh import mesh_contact, single_mesh_drive_forces, torsional_mesh_forces
+from .user_functions import (
+    StallWatchdog,
+    bearing_user_function,
+    lateral_mesh_user_function,
+    load_user_function,
+    mesh_user_function,
+    motor_user_function,
+)
 
 OVT = exu.OutputVariableType
 HIDDEN = VObjectGenericODE2(show=False)
@@ -63,7 +71,7 @@ class BuiltSystem:
     sensors: dict[str, list[int]] = field(default_factory=dict)  # kind -> one sensor per node
     user_functions: list = field(default_factory=list)  # keep references alive
     fixed_coordinates: list[int] = field(default_factory=list)  # held at 0 (CoordinateConstraint)
-    watchdog: _StallWatchdog = field(default_factory=lambda: _StallWatchdog())  # records a stall
+    watchdog: StallWatchdog = field(default_factory=lambda: StallWatchdog())  # records a stall
 
 
 def _add_nodes(mbs, masses: list[tuple[str, float]], q0, v0, *, rotational: bool) -> list[int]:
@@ -193,9 +201,9 @@ def build_torsional(
             )
             continue
         if size == 2:
-            built.user_functions.append(_mesh_user_function(m.parameters))
+            built.user_functions.append(mesh_user_function(m.parameters))
         else:
-            built.user_functions.append(_lateral_mesh_user_function(m, bp, bw, idx))
+            built.user_functions.append(lateral_mesh_user_function(m, bp, bw, idx))
         mbs.AddObject(
             ObjectGenericODE2(
                 nodeNumbers=pair,
@@ -207,7 +215,7 @@ def build_torsional(
     if not modal:
         D = layout.drive
         if layout.motor_at is not None:
-            built.user_functions.append(_motor_user_function(D, built.watchdog))
+            built.user_functions.append(motor_user_function(D, built.watchdog))
             mbs.AddObject(
                 ObjectGenericODE2(
                     nodeNumbers=[nodes[layout.motor_at]],
@@ -217,7 +225,7 @@ def build_torsional(
                 )
             )
         if layout.load_at is not None:
-            built.user_functions.append(_load_user_function(D))
+            built.user_functions.append(load_user_function(D))
             mbs.AddObject(
                 ObjectGenericODE2(
                     nodeNumbers=[nodes[layout.load_at]],
@@ -282,7 +290,7 @@ def _add_bearings(built: BuiltSystem, layout: TorsionalLayout, lateral_u0, modal
                 )
             )
         else:
-            built.user_functions.append(_bearing_user_function(law, sup.free_directions))
+            built.user_functions.append(bearing_user_function(law, sup.free_directions))
             mbs.AddObject(
                 ObjectGenericODE2(
                     nodeNumbers=[nd],
@@ -367,90 +375,3 @@ def _add_drive_and_meshes(built: BuiltSystem, layout: TorsionalLayout) -> None:
             visualization=HIDDEN,
         )
     )
-
-
-def _mesh_user_function(P: np.ndarray):
-    def mesh_force(mbs, t, itemNumber, q, q_t):
-        return torsional_mesh_forces(q[0], q[1], q_t[0], q_t[1], P)
-
-    return mesh_force
-
-
-def _lateral_mesh_user_function(m, bp: Inertia, bw: Inertia, idx: np.ndarray):
-    free = [float(d in b.lateral.free_directions) if b.lateral else 0.0 for b in (bp, bw) for d in (0, 1)]
-    geometry = np.array([*m.line_of_action, *m.friction_direction, *free])
-    P = m.parameters
-
-    def lateral_mesh_force(mbs, t, itemNumber, q, q_t):
-        return lateral_mesh_forces(np.asarray(q), np.asarray(q_t), idx, geometry, P)
-
-    return lateral_mesh_force
-
-
-def _bearing_user_function(law, free_directions: tuple[int, ...]):
-    mask = np.array([float(d in free_directions) for d in (0, 1)])
-    mx, my = float(mask[0]), float(mask[1])
-    if hasattr(law, "force_xy"):
-        force_xy = law.force_xy
-
-        def bearing_force_xy(mbs, t, itemNumber, q, q_t):
-            fx, fy = force_xy(q[0] * mx, q[1] * my, q_t[0] * mx, q_t[1] * my)
-            return [fx * mx, fy * my, 0.0]
-
-        return bearing_force_xy
-
-    def bearing_force(mbs, t, itemNumber, q, q_t):
-        f = np.asarray(law.force_N(np.asarray(q[:2]) * mask, np.asarray(q_t[:2]) * mask), float) * mask
-        return [f[0], f[1], 0.0]
-
-    return bearing_force
-
-
-class StallError(RuntimeError):
-    """Raised from inside a user function when the solver makes no progress in time (Exudyn passes it on
-    as its own error; the watchdog's ``failure`` tells the caller what happened)."""
-
-
-STALL_CALLS = 200_000  # right-hand-side evaluations per check (~30k steps: ~0.1 s simulated normally)
-STALL_ADVANCE_S = 1e-9
-
-
-class _StallWatchdog:
-    """Called with t on every force evaluation: Exudyn's step control can reject steps at the minimum step
-    size forever (no pre-step call happens then), but every attempt evaluates the drive's forces."""
-
-    def __init__(self) -> None:
-        self.calls, self.t_check, self.t_max = 0, -1.0, -1.0
-        self.failure = ""
-
-    def __call__(self, t: float) -> None:
-        self.calls += 1
-        if t > self.t_max:
-            self.t_max = t
-        if self.calls % STALL_CALLS == 0:
-            if self.t_max - self.t_check < STALL_ADVANCE_S:
-                self.failure = (
-                    f"the solver stalled at t = {self.t_max:.9g} s: {STALL_CALLS} force evaluations "
-                    f"advanced less than {STALL_ADVANCE_S:g} s (step size collapse at a discontinuity, "
-                    "e.g. a tooth with stiffness factor 0 next to a loaded one). Hint: use a small "
-                    "non-zero stiffness factor, or loosen solver.relative_tolerance / absolute_tolerance"
-                )
-                raise StallError(self.failure)
-            self.t_check = self.t_max
-
-
-def _motor_user_function(D: np.ndarray, watchdog: _StallWatchdog):
-    """Motor torque (and the stall watchdog)."""
-
-    def motor_torque(mbs, t, itemNumber, q, q_t):
-        watchdog(t)
-        return (motor_torque_at(t, q_t[0], D),)
-
-    return motor_torque
-
-
-def _load_user_function(D: np.ndarray):
-    def load_torque(mbs, t, itemNumber, q, q_t):
-        return (-load_torque_at(t, D),)
-
-    return load_torque
