@@ -168,9 +168,9 @@ from .mesh import _Mesh, _phase_breakpoints_smooth, phase_breakpoints
 from .models import _SingleMesh, _Train
 from .modes import (
     _mesh_force,
-    _ModeConsts,
     _mode_error,
     _mode_mu_sign,
+    _ModeConsts,
     _PairMode,
     _pairs_eval,
     _poly_eval,

@@ -116,4 +116,3 @@ def _train_initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     q0[0] = q0[1] + pinion_torque[0] / shaft_k[0]
     q0[2 * N + 1] = q0[2 * N] - M_L / shaft_k[N]
     return q0, v0
-

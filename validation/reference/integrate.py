@@ -12,7 +12,6 @@ segment ends too (the profiles are linear in between: :func:`_chunk`).
 train) and :mod:`.lateral_model`.  A system provides
 
 * ``n_dof``, ``meshes`` (one :class:`.mesh._Mesh` per mesh), ``speed_prof``, ``load_prof``, ``wsr``;
-* ``initial_y()``: the initial state ``[q, v]``;
 * ``start_chunk(ib, t, tb)``: the profile chunk on [t, tb] (the ib-th time interval);
   ``zero_chunk()``: the chunk used when only t = 0 is output;
 * ``initial_modes(y, chunk)``: ``(modes, extra)``, ``modes[s] = [n, k, c]`` per mesh (phase period,
@@ -58,14 +57,12 @@ def _output_times(scenario: dict, t_eval) -> np.ndarray:
     return t_eval
 
 
-
 def _time_breaks(model, t_stop: float) -> list[float]:
     """Segment ends in time: the break points of the speed and load profiles, and t_stop."""
     tbreaks = {t_stop}
     for prof in (model.speed_prof, model.load_prof):
         tbreaks.update(float(x) for x in prof["time_s"] if 0.0 < float(x) < t_stop)
     return sorted(tbreaks)
-
 
 
 def _chunk(model, ta: float, tb: float, theta_a: float) -> dict:
@@ -88,7 +85,6 @@ def _chunk(model, ta: float, tb: float, theta_a: float) -> dict:
     return {"ta": ta, "tb": tb, "sa": sa, "ss": ss, "la": la, "ls": ls, "theta_a": theta_a, "ws": ws}
 
 
-
 def _contact_edges(lu: float, c: int) -> list[tuple[float, float, int]]:
     """Dead-zone edges to watch from contact state c (1 drive flank, -1 back flank, 0 in the gap):
     (offset of d, crossing direction, contact state after the crossing), with hysteresis _ETA_D."""
@@ -97,7 +93,6 @@ def _contact_edges(lu: float, c: int) -> list[tuple[float, float, int]]:
     if c == -1:
         return [(lu - _ETA_D, 1.0, 0)]
     return [(-(lu + _ETA_D), 1.0, 1), (lu + _ETA_D, -1.0, -1)]
-
 
 
 def _segment(rhs, t: float, tb: float, y, events, method: str, rtol: float, atol, first):
@@ -129,7 +124,6 @@ def _segment(rhs, t: float, tb: float, y, events, method: str, rtol: float, atol
         return res, t_new, y_new, fired, 0
     t_new = float(missed[1])
     return res, t_new, res.sol(t_new), [missed[0]], 1
-
 
 
 def _scan_missed_events(sol, events: list, t0: float, t1: float, n_sub: int = 16):
@@ -177,7 +171,6 @@ def _scan_missed_events(sol, events: list, t0: float, t1: float, n_sub: int = 16
     return best
 
 
-
 def _step_hint(res, h_prev):
     """First step for the next segment: the last full step size solve_ivp took."""
     ts_steps = res.sol.ts
@@ -188,15 +181,14 @@ def _step_hint(res, h_prev):
     return h_prev
 
 
-
-def integrate(system, t_eval: np.ndarray, rtol: float, atol, method: str) -> dict:
-    """Segmented integration of ``system`` over the output times ``t_eval`` (see the module docstring).
+def integrate(system, y: np.ndarray, t_eval: np.ndarray, rtol: float, atol, method: str) -> dict:
+    """Segmented integration of ``system`` from the initial state ``y = [q, v]`` at t = 0 over the output
+    times ``t_eval`` (see the module docstring).
 
     Returns Y (2 n_dof x n_t states), out (the system's output arrays), nfev, n_segments (restarts of
     solve_ivp) and n_missed (mode boundaries found inside a step by the dense scan).
     """
     t_stop = float(t_eval[-1])
-    y = system.initial_y()
     n_t = t_eval.size
     Y = np.full((2 * system.n_dof, n_t), np.nan)
     out = system.output_buffers(n_t)

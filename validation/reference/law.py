@@ -44,7 +44,6 @@ def total_error(scenario: dict, u):
     return E + runout_error(scenario, u) + pit_error(scenario, p, i, j)
 
 
-
 def pair_law(scenario: dict, m, q):
     """Tooth factor f_i g_j and error (triangle + pits, no run-out) of the pair of mesh period m
     (i = m mod z1, j = m mod z2) evaluated at phase q (possibly outside [0, 1))."""
@@ -56,7 +55,6 @@ def pair_law(scenario: dict, m, q):
     a = float(scenario["production"]["error_mode"]["a"])
     E = error_shape_ext(q, a, tooth_error_amplitudes(scenario)[i]) + pit_error(scenario, q, i, j)
     return f[i] * g[j], E
-
 
 
 def blended_law(scenario: dict, u) -> tuple[np.ndarray, np.ndarray]:
@@ -81,7 +79,6 @@ def blended_law(scenario: dict, u) -> tuple[np.ndarray, np.ndarray]:
     else:
         fg, E = fg_in, E_in
     return fg, E + runout_error(scenario, u)
-
 
 
 def pair_stiffness(scenario: dict, u, healthy: bool = False):
@@ -112,7 +109,6 @@ def pair_stiffness(scenario: dict, u, healthy: bool = False):
     return k
 
 
-
 def effective_stiffness(scenario: dict, u) -> tuple[np.ndarray, np.ndarray]:
     """Stiffness k of the law at the mesh coordinate u and the factor of its damping: k_z(p) f_i g_j and
     f_i g_j (w > 0: the blended factor); "pairs": the pair sum and k / k_healthy."""
@@ -130,7 +126,6 @@ def effective_stiffness(scenario: dict, u) -> tuple[np.ndarray, np.ndarray]:
         fg = f[np.mod(n, int(scenario["design"]["pinion"]["teeth"]))]
         fg = fg * g[np.mod(n, int(scenario["design"]["wheel"]["teeth"]))]
     return base_stiffness(p, mesh) * fg, fg
-
 
 
 def mesh_force_literal(scenario: dict, u, delta, delta_dot) -> dict:
@@ -176,7 +171,6 @@ def mesh_force_literal(scenario: dict, u, delta, delta_dot) -> dict:
     }
 
 
-
 def friction_moments(scenario: dict, p, F) -> dict:
     """T = mu |F| s and the moments M_zt1 = T rho_1, M_zt2 = T rho_2 (literal)."""
     d_ = scenario["design"]
@@ -192,4 +186,3 @@ def friction_moments(scenario: dict, p, F) -> dict:
     rho1 = r1 * tan_a + (p - ppp) * pb
     rho2 = r2 * tan_a - (p - ppp) * pb
     return {"T": T, "rho1": rho1, "rho2": rho2, "M_zt1": T * rho1, "M_zt2": T * rho2}
-

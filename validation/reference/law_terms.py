@@ -24,14 +24,12 @@ def random_l(seed: int, z1: int, stage: int = 0) -> np.ndarray:
     return np.random.default_rng([seed, stage]).random(z1)
 
 
-
 def tooth_error_amplitudes(scenario: dict) -> np.ndarray:
     """e_i = [1 - r (1 - l[i])] e in metres, one per pinion tooth (train stage: meta.stage_index)."""
     em = scenario["production"]["error_mode"]
     z1 = int(scenario["design"]["pinion"]["teeth"])
     l_rand = random_l(int(scenario["meta"]["seed"]), z1, int(scenario["meta"].get("stage_index", 0)))
     return (1.0 - float(em["r"]) * (1.0 - l_rand)) * float(em["e_um"]) * 1e-6
-
 
 
 def error_shape(p, a: float, e_i):
@@ -41,7 +39,6 @@ def error_shape(p, a: float, e_i):
     rise = e_i * p / a if a > 0.0 else np.zeros(np.broadcast(p, e_i).shape)
     fall = e_i * (1.0 - p) / (1.0 - a) if a < 1.0 else np.zeros(np.broadcast(p, e_i).shape)
     return np.where(p < a, rise, fall)
-
 
 
 def runout_terms(scenario: dict) -> list[tuple[float, float, int]]:
@@ -58,7 +55,6 @@ def runout_terms(scenario: dict) -> list[tuple[float, float, int]]:
     return out
 
 
-
 def runout_error(scenario: dict, u):
     """Run-out error + A_p sin(phi_p + theta_p) + A_w sin(phi_w* + theta_w) at the mesh coordinate u."""
     u = np.asarray(u, dtype=float)
@@ -66,7 +62,6 @@ def runout_error(scenario: dict, u):
     for amp, theta, z in runout_terms(scenario):
         E = E + amp * np.sin(TWO_PI * u / z + theta)
     return E
-
 
 
 def pitted_teeth(scenario: dict) -> list[tuple[str, int, float, float, float]]:
@@ -82,7 +77,6 @@ def pitted_teeth(scenario: dict) -> list[tuple[str, int, float, float, float]]:
             raise ValueError(f"pit phases need 0 <= start_phase < end_phase <= 1, got {lo}, {hi}")
         out.append((gear, tooth, float(entry["depth_um"]) * 1e-6, lo, hi))
     return out
-
 
 
 def pit_error(scenario: dict, p, i, j):
@@ -104,12 +98,10 @@ def pit_error(scenario: dict, p, i, j):
     return E
 
 
-
 def smooth_step(x):
     """C2 smooth step: S(x) = 0 for x <= -1/2, 1 for x >= 1/2, u^3 (10 - 15 u + 6 u^2), u = x + 1/2."""
     u = np.clip(np.asarray(x, dtype=float) + 0.5, 0.0, 1.0)
     return u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
-
 
 
 def transition_width(mesh: dict) -> float:
@@ -118,7 +110,6 @@ def transition_width(mesh: dict) -> float:
     if not 0.0 <= w <= 0.1:
         raise ValueError(f"transition_width must lie in [0, 0.1], got {w}")
     return w
-
 
 
 def check_transition_width(scenario: dict) -> float:
@@ -143,7 +134,6 @@ def check_transition_width(scenario: dict) -> float:
     return w
 
 
-
 def error_shape_ext(q, a: float, e_i):
     """Triangular shape extended by its straight lines outside [0, 1): the rising line e_i q / a where
     it applies (q < a; for a = 1 also above 1), the falling line e_i (1 - q) / (1 - a) otherwise (q >= a;
@@ -157,7 +147,6 @@ def error_shape_ext(q, a: float, e_i):
     return np.where(use_rise, rise, fall)
 
 
-
 def friction_sign(p, pitch_point_phase: float, w: float = 0.0):
     """s = +1 for p < pitch, -1 otherwise (w = 0); with w > 0 and 0 < pitch < 1:
     s = 2 [S(p/w) - S((p - pitch)/w) + S((p - 1)/w)] - 1; pitch 0 or 1: constant sign."""
@@ -166,7 +155,6 @@ def friction_sign(p, pitch_point_phase: float, w: float = 0.0):
     if w > 0.0 and 0.0 < ppp < 1.0:
         return 2.0 * (smooth_step(p / w) - smooth_step((p - ppp) / w) + smooth_step((p - 1.0) / w)) - 1.0
     return np.where(p < ppp, 1.0, -1.0)
-
 
 
 def mesh_law(mesh: dict) -> str:
@@ -182,11 +170,9 @@ def mesh_law(mesh: dict) -> str:
     return law
 
 
-
 def half_double(mesh: dict) -> float:
     """h = (contact_ratio - 1) / 2."""
     return (float(mesh["contact_ratio"]) - 1.0) / 2.0
-
 
 
 def pair_table(mesh: dict) -> tuple[np.ndarray, np.ndarray, dict[tuple[str, int], np.ndarray]]:
@@ -215,7 +201,6 @@ def pair_table(mesh: dict) -> tuple[np.ndarray, np.ndarray, dict[tuple[str, int]
     return grid, K, ratios
 
 
-
 def contact_weight(q, h: float, w: float = 0.0):
     """Contact weight of a pair at its own phase q: 1 for -h <= q < 1 + h, else 0;
     with a transition width w > 0: S((q + h)/w) [1 - S((q - 1 - h)/w)]."""
@@ -223,7 +208,6 @@ def contact_weight(q, h: float, w: float = 0.0):
     if w > 0.0:
         return smooth_step((q + h) / w) * (1.0 - smooth_step((q - 1.0 - h) / w))
     return np.where((-h <= q) & (q < 1.0 + h), 1.0, 0.0)
-
 
 
 def base_stiffness(p, mesh: dict):
@@ -252,7 +236,6 @@ def base_stiffness(p, mesh: dict):
     return np.interp(p, ph, kk, period=1.0)
 
 
-
 def tooth_factors(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     """f (pinion, z1 values) and g (wheel, z2 values); 1 unless listed in condition.damaged_teeth.
 
@@ -271,11 +254,9 @@ def tooth_factors(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     return f, g
 
 
-
 def reduced_mass(scenario: dict) -> float:
     """m = 1 / (r1^2 / I_1p + r2^2 / I_2p)."""
     d = scenario["design"]
     r1, r2 = float(d["pinion"]["base_radius_m"]), float(d["wheel"]["base_radius_m"])
     i1, i2 = float(d["pinion"]["inertia_kg_m2"]), float(d["wheel"]["inertia_kg_m2"])
     return 1.0 / (r1 * r1 / i1 + r2 * r2 / i2)
-

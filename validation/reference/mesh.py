@@ -55,7 +55,6 @@ def phase_breakpoints(scenario: dict) -> np.ndarray:
     return np.array(keep)
 
 
-
 def _phase_breakpoints_smooth(scenario: dict, w: float) -> np.ndarray:
     """Break points with a transition width w > 0: each smoothed jump at p_c becomes a C2 ramp on
     [p_c - w/2, p_c + w/2] whose ends (where the third derivative jumps) are break points, taken
@@ -88,7 +87,6 @@ def _phase_breakpoints_smooth(scenario: dict, w: float) -> np.ndarray:
         if x - keep[-1] > 1e-9 and 1.0 - x > 1e-9:
             keep.append(x)
     return np.array(keep)
-
 
 
 class _Mesh:
@@ -321,4 +319,3 @@ class _Mesh:
         elif k < 0:
             k, n = self.K - 1, n - 1
         return n, k
-

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .initial import initial_state
 from .integrate import _ETA_U, _chunk, _contact_edges
 from .mesh import _Mesh
 from .modes import _mesh_force, _mode_error, _poly_eval
@@ -59,9 +58,6 @@ class _SingleMesh(_Mesh):
         return y[self.n_dof] * self.cz
 
     # -- system interface of integrate() -------------------------------------------------------
-    def initial_y(self) -> np.ndarray:
-        return np.concatenate(initial_state(self.sc))
-
     def start_chunk(self, ib: int, t: float, tb: float) -> dict:
         """Chunk on [t, tb]; muller: the prescribed angle continues from theta(t) of the last chunk."""
         theta_a = 0.0 if ib == 0 else self.theta(t)
@@ -99,7 +95,7 @@ class _SingleMesh(_Mesh):
 
     # -- right-hand sides ----------------------------------------------------------------------
     def make_rhs(self, modes: list, extra, chunk: dict):
-        (n, k, c), = modes
+        ((n, k, c),) = modes
         mc = self.mode_consts(n, k, c)
         s = self.iv[k][4]
         mus = self.mu * s
@@ -150,7 +146,7 @@ class _SingleMesh(_Mesh):
     # -- events --------------------------------------------------------------------------------
     def make_events(self, modes: list, extra, mcs: list):
         """Terminal events leaving the locked mode; each carries the resulting mode change."""
-        (n, k, c), = modes
+        ((n, k, c),) = modes
         mc = mcs[0]
         lo = n + float(self.bA[k]) - _ETA_U
         hi = n + float(self.bB[k]) + _ETA_U
@@ -243,9 +239,6 @@ class _Train:
         return delta + _mode_error(self.meshes[s].mode_consts(n, k, 0), u - n), ddot
 
     # -- system interface of integrate() -------------------------------------------------------
-    def initial_y(self) -> np.ndarray:
-        return np.concatenate(initial_state(self.sc))
-
     def start_chunk(self, ib: int, t: float, tb: float) -> dict:
         return _chunk(self, t, tb, 0.0)
 
@@ -370,4 +363,3 @@ class _Train:
         ang = min(rtol * m.defl_scale / max(m.r1, m.r2) for m in self.meshes)
         om = max(m.omega_n for m in self.meshes)
         return np.concatenate((np.full(self.n_dof, ang), np.full(self.n_dof, ang * om)))
-

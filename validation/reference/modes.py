@@ -8,9 +8,12 @@ built per mode by :class:`.mesh._Mesh`.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .mesh import _Mesh
 
 
 # ----------------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .initial import initial_state
 from .integrate import _output_times, integrate
 from .models import _SingleMesh, _Train
 from .scenario import is_train
@@ -33,7 +34,8 @@ def simulate_reference(
     t_eval = _output_times(scenario, t_eval)
     if atol is None:
         atol = model.default_atol(rtol)
-    res = integrate(model, t_eval, rtol, atol, method)
+    q0, v0 = initial_state(scenario)
+    res = integrate(model, np.concatenate((q0, v0)), t_eval, rtol, atol, method)
     nd, Y, F_out = model.n_dof, res["Y"], res["out"]["F"]
     stats = {
         "nfev": np.array(res["nfev"]),
