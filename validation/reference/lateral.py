@@ -1,5 +1,5 @@
 """Independent reference model for the *lateral* gear models of ``docs/scenario.md`` (section "Lateral
-models: gears on bearings (Figs. 17, 18)"): gears of a ``one-stage`` scene or of a ``train`` whose
+models: gears on bearings (Figs. 17, 18)"): gears of a ``train`` whose
 centres translate in the housing's x-y plane on a ``linear`` or ``hertzian`` bearing (topology
 ``train``, canonical or legacy shape; a legacy ``one-stage`` is read as its 1-stage train).
 

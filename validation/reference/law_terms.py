@@ -42,9 +42,10 @@ def error_shape(p, a: float, e_i):
 
 
 def runout_terms(scenario: dict) -> list[tuple[float, float, int]]:
-    """Run-out entries of production.eccentricity (missing key: none) as (A, theta, z): A = amplitude_um
-    * 1e-6, theta = radians(phase_deg) and z the teeth of that gear, so that each term is
-    A sin(2 pi u / z + theta) (pinion: phi_p = 2 pi u / z1; wheel: phi_w* = 2 pi u / z2)."""
+    """Run-out entries of the stage's eccentricity (mesh view: production.eccentricity; missing key:
+    none) as (A, theta, z): A = amplitude_um * 1e-6, theta = radians(phase_deg) and z the teeth of that
+    gear, so that each term is A sin(2 pi u / z + theta) (pinion: phi_p = 2 pi u / z1; wheel:
+    phi_w* = 2 pi u / z2)."""
     teeth = {g: int(scenario["design"][g]["teeth"]) for g in ("pinion", "wheel")}
     out = []
     for entry in scenario.get("production", {}).get("eccentricity", []):
@@ -65,7 +66,8 @@ def runout_error(scenario: dict, u):
 
 
 def pitted_teeth(scenario: dict) -> list[tuple[str, int, float, float, float]]:
-    """condition.pitted_teeth (missing key: none) as (gear, tooth, depth in m, start_phase, end_phase)."""
+    """The stage's pitted_teeth (mesh view: condition.pitted_teeth; missing key: none) as
+    (gear, tooth, depth in m, start_phase, end_phase)."""
     z = {g: int(scenario["design"][g]["teeth"]) for g in ("pinion", "wheel")}
     out = []
     for entry in scenario.get("condition", {}).get("pitted_teeth", []):
@@ -113,7 +115,7 @@ def transition_width(mesh: dict) -> float:
 
 
 def check_transition_width(scenario: dict) -> float:
-    """The transition width w of a one-stage-shaped scenario, with the limits of the spec checked:
+    """The transition width w of a mesh view, with the limits of the spec checked:
     w <= min(2h, 1 - 2h) (every law but "table": the ramps at h and 1 - h), w/2 <= pitch_point_phase
     <= 1 - w/2 (unless 0 or 1), every pit at least w wide."""
     mesh = scenario["design"]["mesh"]
@@ -237,7 +239,8 @@ def base_stiffness(p, mesh: dict):
 
 
 def tooth_factors(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
-    """f (pinion, z1 values) and g (wheel, z2 values); 1 unless listed in condition.damaged_teeth.
+    """f (pinion, z1 values) and g (wheel, z2 values); 1 unless listed in the stage's damaged_teeth
+    (mesh view: condition.damaged_teeth).
 
     A tooth listed more than once gets the product of its factors (assumption, see report).
     """

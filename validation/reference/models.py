@@ -359,7 +359,8 @@ class _Train:
         return events, actions
 
     def default_atol(self, rtol: float) -> np.ndarray:
-        """Same rule as one-stage, with the smallest angle scale and the fastest mesh of all stages."""
+        """Same rule as the one-mesh scenes, with the smallest angle scale and the fastest mesh of all
+        stages."""
         ang = min(rtol * m.defl_scale / max(m.r1, m.r2) for m in self.meshes)
         om = max(m.omega_n for m in self.meshes)
         return np.concatenate((np.full(self.n_dof, ang), np.full(self.n_dof, ang * om)))
