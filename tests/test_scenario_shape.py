@@ -137,3 +137,41 @@ def test_four_periods_preset_is_the_paper_run_of_the_one_stage_scene():
     assert gb.four_periods(2.0) == sc.operation
     with pytest.raises(ScenarioError, match="four_periods"):
         gb.four_periods(1.0, run_up_s=2.0)
+
+
+def test_studies_vary_and_draw_per_stage_keys_and_refuse_shorthand_on_trains(tmp_path):
+    from gearbody.studies import Study, run_study
+
+    study = Study.build(
+        "two-stage",
+        vary=["design.stages.2.mesh.backlash_um=5,20"],
+        random=["design.stages.1.error_mode.e_um=uniform(5,15)"],
+        samples=2,
+    )
+    scenarios = [study.load_case(case) for case in study.cases()]
+    assert sorted({sc.stages[1].mesh.backlash_um for sc in scenarios}) == [5.0, 20.0]
+    assert all(5 <= sc.stages[0].error_mode.e_um <= 15 for sc in scenarios)
+    assert all(sc.stages[1].error_mode == scenarios[0].stages[1].error_mode for sc in scenarios)
+    with pytest.raises(ScenarioError, match="production.error_mode does not apply to a drive of 2 stages"):
+        run_study("two-stage", vary=["production.error_mode.e_um=5,50"], out_dir=tmp_path, progress=False)
+    assert not any(tmp_path.glob("cases/*/summary.json"))  # refused before anything ran
+
+
+def test_the_installed_layout_has_no_mapped_package_under_gearbody():
+    import sys
+
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover
+        import tomli as tomllib
+    from pathlib import Path
+
+    pyproject = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
+    mapped = pyproject["tool"]["setuptools"]["package-dir"]
+    assert mapped and not [name for name in mapped if name == "gearbody" or name.startswith("gearbody.")]
+    packages = set(pyproject["tool"]["setuptools"]["packages"])
+    on_disk = {
+        ".".join(p.parent.relative_to(Path(gb.__file__).parents[1]).parts)
+        for p in Path(gb.__file__).parent.rglob("__init__.py")
+    }
+    assert on_disk <= packages, f"packages missing from pyproject.toml: {sorted(on_disk - packages)}"

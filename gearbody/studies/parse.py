@@ -28,7 +28,7 @@ __all__ = [
     "toml_value",
 ]
 
-_KEY = re.compile(r"^[A-Za-z_][\w-]*(\.[A-Za-z_][\w-]*)*$")
+_KEY = re.compile(r"^[A-Za-z_][\w-]*(\.([A-Za-z_][\w-]*|[1-9][0-9]*))*$")  # list items by number from 1
 _DIST = re.compile(r"^\s*(\w+)\s*\((.*)\)\s*$", re.DOTALL)
 _NUMBER = r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?"
 
@@ -85,7 +85,8 @@ def _number(text: str, label: str, what: str) -> float:
 def check_key(key: str, label: str) -> None:
     if not _KEY.match(key):
         raise SweepSpecError(
-            f"{label}: {key!r} is not a dotted scenario key (e.g. production.error_mode.e_um)"
+            f"{label}: {key!r} is not a dotted scenario key (e.g. production.error_mode.e_um, or "
+            "design.stages.2.mesh.backlash_um for stage 2 of a train)"
         )
 
 
