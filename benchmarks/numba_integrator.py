@@ -1,4 +1,6 @@
 """Compiled equation-level integrator of the torsional scenes: the practical speed limit of the benchmark.
+A benchmark yardstick, not library code: self-contained on purpose (~680 lines), so that nothing in it
+depends on how gearbody's engine is organised.
 
 Not part of gearbody: a self-contained adaptive Dormand-Prince 5(4) integrator (FSAL; step-size control
 of Hairer's DOPRI5: error norm sqrt(mean((e_i / sc_i)^2)), sc_i = atol_i + rtol_i max(|y0_i|, |y1_i|),
@@ -13,9 +15,9 @@ built generically from :func:`gearbody.assembly.torsional_layout` (inertias; sha
 with M = k (phi_i - phi_j) + C (phi_i' - phi_j'), -M on i and +M on j, as Exudyn's coordinate spring-
 damper; one mesh per stage) and :func:`gearbody.assembly.initial_state`. The force laws are
 gearbody's own compiled kernels, called from the compiled loop, so the physics is identical to
-``gearbody/engine/build.py``: ``torsional_mesh_forces(phi_p, phi_w, w_p, w_w, P)`` on the pinion and
-wheel nodes (``_mesh_user_function``), ``+motor_torque_at(t, w_motor, D)`` on the motor node
-(``_motor_user_function``) and ``-load_torque_at(t, D)`` on the machine node (``_load_user_function``).
+``gearbody/engine/user_functions.py``: ``torsional_mesh_forces(phi_p, phi_w, w_p, w_w, P)`` on the pinion and
+wheel nodes (``engine.user_functions.mesh_user_function``), ``+motor_torque_at(t, w_motor, D)`` on the motor node
+(``motor_user_function``) and ``-load_torque_at(t, D)`` on the machine node (``load_user_function``).
 The reported mesh force is ``mesh_contact_series(phi_p, r1 phi_p - r2 phi_w, r1 w_p - r2 w_w, P)`` of the
 dense-output states at the output times, as gearbody's own post-processing does.
 

@@ -21,6 +21,9 @@ tooth change), is spread over ``|p - p_jump| < w / 2`` by the C2 smooth step :fu
 Across the tooth change the factor and the error are blended between the outgoing and incoming pairs
 (each evaluated with its own phase, p + 1 or p - 1). Each ramp is antisymmetric about its centre, so the
 mean stiffness over a period is unchanged. docs/scenario.md, "Transition width".
+
+The module stays whole (~480 lines): every compiled function here reads the one packed parameter layout
+(the ``I_*`` offsets) and numba compiles them together; split, the layout would be written twice.
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""Where every part of a drive sits in 3D, derived from the scenario alone (no Exudyn).
+"""Where every part of a drive sits in 3D, derived from the scenario alone (no Exudyn). One concern, the
+placing rules, kept in one module (~400 lines) so that each size rule is stated once, where it is used.
 
 Gear axes are parallel to z. Stage s's wheel axis lies one centre distance a_s = r_1 + r_2 (pitch
 radii r = r_b / cos(alpha), standard gears without profile shift) from its pinion axis, in the

@@ -2,7 +2,9 @@
 as its 1-stage train) whose gears may translate in the housing's x-y plane on linear or hertzian
 bearings.  The meshes are the torsional reference's :class:`.mesh._Mesh` (so every stiffness profile,
 the faults and the transition width come with it); the hertzian bearings add a mode each (out of
-contact, pushing, clamped at f_r <= 0), see the docstring of :mod:`.lateral`.
+contact, pushing, clamped at f_r <= 0), see the docstring of :mod:`.lateral`. One class, one right-hand
+side (~410 lines): its coordinates, modes and events are read together when checking it against the
+contract, so it stays whole.
 """
 
 from __future__ import annotations
