@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from gearbody_validation import reference as ref
 from gearbody_validation import reference_lateral as lat
+from shapes import legacy
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SCEN = ROOT / "validation" / "scenarios"
@@ -51,7 +52,7 @@ def to_canonical(sc: dict) -> dict:
 
 
 def short(path: pathlib.Path, t_end: float) -> dict:
-    sc = copy.deepcopy(ref.load_scenario(path))
+    sc = legacy(ref.load_scenario(path))
     sc["operation"]["t_end_s"] = t_end
     return sc
 

@@ -16,6 +16,7 @@ import pytest
 from gearbody_validation import reference as ref
 from gearbody_validation import reference_lateral as lat
 from scipy.integrate import solve_ivp
+from shapes import legacy
 
 from gearbody.model import load_scenario, scenario_to_dict
 
@@ -38,7 +39,7 @@ PITS = [  # pinion tooth 0 and wheel tooth 29 meet at n = 29 (and the pits overl
 
 
 def one_stage(*overrides: str) -> dict:
-    return scenario_to_dict(load_scenario("one-stage", list(overrides)))
+    return legacy(scenario_to_dict(load_scenario("one-stage", list(overrides))))
 
 
 def with_faults(sc: dict, runouts=RUNOUTS, pits=PITS) -> dict:
@@ -333,7 +334,7 @@ def test_lateral_reference_with_faults():
             [*STEADY, "production.error_mode={a=0.5,e_um=10.0,r=0.3}", "operation.t_end_s=0.005"],
         )
     )
-    sc = with_faults(sc)
+    sc = with_faults(legacy(sc))
     res = lat.simulate_reference_lateral(sc)
     d = sc["design"]
     r1, r2 = d["pinion"]["base_radius_m"], d["wheel"]["base_radius_m"]

@@ -16,6 +16,7 @@ import sys
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
+from shapes import legacy
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
@@ -33,7 +34,7 @@ STEADY = {
 
 
 def scene(name: str, t_end: float, steady: bool = True) -> dict:
-    sc = copy.deepcopy(ref.load_scenario(SCENES / f"{name}.toml"))
+    sc = legacy(ref.load_scenario(SCENES / f"{name}.toml"))
     if steady:
         sc["operation"].update(copy.deepcopy(STEADY))
     sc["operation"]["t_end_s"] = t_end

@@ -351,7 +351,11 @@ def test_train_stage_agrees_with_gearbody():
     from gearbody.engine import simulate
     from gearbody.model import load_scenario, scenario_to_dict
 
-    data = scenario_to_dict(load_scenario("two-stage-geometry", [*STEADY, "operation.t_end_s=0.05"]))
+    stage_errors = [f"design.stages.{k}.error_mode={{a=0.5,e_um=10.0,r=0.3}}" for k in (1, 2)]
+    steady = [o for o in STEADY if not o.startswith("production.")]  # a train: per-stage error modes
+    data = scenario_to_dict(
+        load_scenario("two-stage-geometry", [*steady, *stage_errors, "operation.t_end_s=0.05"])
+    )
     stage = data["design"]["stages"][1]
     stage["damaged_teeth"] = [{"gear": "wheel", "tooth": 5, "crack_depth_mm": 4.0}]
     stage["mesh"]["transition_width"] = 0.02
@@ -370,10 +374,11 @@ def test_lateral_agrees_with_gearbody():
     from gearbody.model import load_scenario, scenario_to_dict
 
     data = scenario_to_dict(load_scenario("lateral-8dof", [*STEADY, "operation.t_end_s=0.03"]))
+    stage = data["design"]["stages"][0]
     for gear in ("pinion", "wheel"):
-        del data["design"][gear]["base_radius_m"]
-        data["design"][gear].pop("face_width_m", None)
-    data["design"]["mesh"] = {
+        del stage[gear]["base_radius_m"]
+        stage[gear].pop("face_width_m", None)
+    stage["mesh"] = {
         "stiffness_profile": "potential-energy",
         "damping_Ns_per_m": 7000.0,
         "geometry": {
@@ -385,7 +390,7 @@ def test_lateral_agrees_with_gearbody():
             "thickness_allowance_wheel_um": -53.2,
         },
     }
-    data["condition"]["damaged_teeth"] = [{"gear": "wheel", "tooth": 3, "crack_depth_mm": 3.0}]
+    stage["damaged_teeth"] = [{"gear": "wheel", "tooth": 3, "crack_depth_mm": 3.0}]
     sc = load_scenario(data)
     res = simulate(sc)
     out = simulate_reference_lateral(reference_input(sc), t_eval=res.time_s)

@@ -308,7 +308,9 @@ def test_two_stage_train_with_per_stage_widths_agrees_with_gearbody():
     from gearbody.engine import simulate
     from gearbody.model import load_scenario, scenario_to_dict
 
-    data = scenario_to_dict(load_scenario("two-stage", [b for b in BASE if "transition_width" not in b]))
+    base = [b for b in BASE if "transition_width" not in b and not b.startswith("production.")]
+    stage_errors = [f"design.stages.{k}.error_mode={{a=0.5,e_um=10.0,r=0.3}}" for k in (1, 2)]
+    data = scenario_to_dict(load_scenario("two-stage", [*base, *stage_errors]))
     stages = data["design"]["stages"]
     stages[0]["mesh"]["transition_width"] = 0.01
     stages[1]["mesh"]["transition_width"] = 0.02

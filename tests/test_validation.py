@@ -25,7 +25,7 @@ def test_comparison_detects_a_model_difference():
     res = simulate(sc)
     other = scenario_to_dict(sc)
     other["design"]["stages"][0]["mesh"]["damping_Ns_per_m"] *= 1.2
-    other["production"]["error_mode"]["e_um"] = 12.0
+    other["design"]["stages"][0]["error_mode"]["e_um"] = 12.0
     ref = simulate_reference(other, t_eval=res.time_s)
     assert np.max(np.abs(res.mesh_force - ref["mesh_force_N"])) / sc.rated_mesh_force_N > 0.005
 
