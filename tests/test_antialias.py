@@ -119,6 +119,7 @@ def one_stage_pair():
     return on, off
 
 
+@pytest.mark.slow
 def test_simulated_mesh_force_loses_its_aliases_but_keeps_its_harmonics(one_stage_pair):
     on, off = one_stage_pair
     window = on.time_s >= on.time_s[-1] - 1.0

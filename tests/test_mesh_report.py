@@ -168,6 +168,7 @@ def test_cli_refuses_bad_stage_and_load(capsys):
     assert main(["mesh", "one-stage", "--set", "design.mesh.contact_ratio=3", "--no-plots"]) == 2
 
 
+@pytest.mark.slow
 def test_report_is_engine_free(tmp_path):
     code = (
         "import sys; from gearbody.model import load_scenario; "

@@ -69,6 +69,7 @@ def _line(res, f_hz: float) -> float:
     return peak_near(spectrum, f_hz, 2 * spectrum.resolution_hz)
 
 
+@pytest.mark.slow
 def test_second_stage_mesh_lines_reach_the_first_stage_where_kinematics_puts_them(two_stage_run, control_run):
     res = two_stage_run
     window = res.time_s >= res.time_s[-1] - RECORD_S

@@ -171,6 +171,7 @@ def test_steady_initial_state_uses_the_total_error():
 # ---------------------------------------------------------------------------------------------
 # Simulations
 # ---------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_wheel_runout_gives_a_line_at_the_wheel_rotation_frequency():
     """Steady rated one-stage, 20 um run-out of the wheel: the mesh force spectrum over two wheel
     revolutions (detrended, Hann) has a line at f_w = w_wheel / 2 pi. Measured 13.8 N with, 0.04 N
@@ -234,6 +235,7 @@ def test_outputs_match_the_literal_law_with_faults(scene):
         assert res["kd"].max() > 2.0 and np.any(res["kd"] == 0.0)
 
 
+@pytest.mark.slow
 def test_agrees_with_brute_force_literal_integration_with_faults():
     """Separation with backlash plus run-out (large, to move the contact edges) and pits: segmented
     integration vs a plain tight adaptive integration of the literal right-hand side."""

@@ -336,6 +336,7 @@ def _literal_rhs(sc: dict):
     return rhs
 
 
+@pytest.mark.slow
 def test_agrees_with_brute_force_literal_integration():
     """Hertzian bearings with contact loss (light load, large errors, small backlash: bearings and teeth
     separate): the segmented reference vs a plain tight-tolerance integration of the literal equations

@@ -330,6 +330,7 @@ def _max_error(res, out, sc) -> float:
     return err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", list(ONE_STAGE))
 def test_one_stage_geometry_agrees_with_gearbody(case):
     from gearbody_validation.compare import reference_input

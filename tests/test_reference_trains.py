@@ -204,6 +204,7 @@ def test_two_stage_steady_start_is_an_equilibrium():
     np.testing.assert_allclose(v, v[:, :1] * np.ones_like(v), rtol=1e-7)
 
 
+@pytest.mark.slow
 def test_two_stage_steady_running_mean_force_and_kinematics():
     """Steady running (file as is, 0.1 s): mean F_s over whole mesh periods of stage s is F_rated,s
     (friction moves it by < 1 %), and on average w_w = w_p z1/z2 in every stage (the mesh itself
@@ -229,6 +230,7 @@ def test_two_stage_steady_running_mean_force_and_kinematics():
         assert np.mean(res["stage_kd"][s, w]) == pytest.approx(1.0, abs=1e-3)
 
 
+@pytest.mark.slow
 def test_two_stage_accuracy_default_vs_tighter():
     """Default rtol vs 10x tighter differ by far less than 0.05 % of F_rated,s (measured ~6e-6 %)."""
     sc = load("two-stage-steady", 0.1)
@@ -285,6 +287,7 @@ def _literal_train_rhs(sc: dict):
     return rhs
 
 
+@pytest.mark.slow
 def test_agrees_with_brute_force_literal_integration():
     """Two stages separating (stage 2 also in back-flank contact): segmented integration vs a plain
     tight adaptive integration of the literal train equations (measured 2e-7 of F_rated,s)."""

@@ -22,6 +22,7 @@ def steady_run():
     return simulate(sc)
 
 
+@pytest.mark.slow
 def test_report_is_one_self_contained_page(steady_run, tmp_path):
     path = write_report(steady_run, tmp_path / "report.html")
     text = path.read_text()

@@ -239,6 +239,7 @@ def test_a_process_pool_gives_the_serial_results_bit_for_bit(serial, tmp_path):
         assert np.array_equal(_force(out, cid), _force(serial[0], cid))
 
 
+@pytest.mark.slow
 def test_a_dask_cluster_gives_the_serial_results_bit_for_bit(serial, tmp_path):
     from dask.distributed import LocalCluster
 

@@ -8,6 +8,8 @@ from gearbody_validation.reference import simulate_reference
 from gearbody.engine import simulate
 from gearbody.model import load_scenario, scenario_to_dict
 
+pytestmark = pytest.mark.slow  # every test here runs gearbody and the reference
+
 
 @pytest.mark.parametrize("scene", VALIDATED_SCENES)
 def test_scene_agrees_with_independent_reference_within_half_a_percent(scene):
