@@ -86,6 +86,7 @@ def test_second_stage_mesh_lines_reach_the_first_stage_where_kinematics_puts_the
     assert _line(res, f_z1).amplitude > 5 * _line(res, f_z2).amplitude  # the first stage's own line leads
 
 
+@pytest.mark.slow
 def test_first_stage_mesh_line_has_sidebands_at_the_second_mesh_frequency(two_stage_run, control_run):
     """Fig. 20: f_z1 +- f_z2 in the intermediate shaft's first-stage wheel acceleration (band-limited),
     at the kinematic frequencies within the FFT resolution, well over their band and the control run."""
