@@ -15,8 +15,8 @@ built generically from :func:`gearbody.assembly.torsional_layout` (inertias; sha
 with M = k (phi_i - phi_j) + C (phi_i' - phi_j'), -M on i and +M on j, as Exudyn's coordinate spring-
 damper; one mesh per stage) and :func:`gearbody.assembly.initial_state`. The force laws are
 gearbody's own compiled kernels, called from the compiled loop, so the physics is identical to
-``gearbody/engine/user_functions.py``: ``torsional_mesh_forces(phi_p, phi_w, w_p, w_w, P)`` on the pinion and
-wheel nodes (``engine.user_functions.mesh_user_function``), ``+motor_torque_at(t, w_motor, D)`` on the motor node
+``gearbody/engine/user_functions.py``: ``torsional_mesh_forces(phi_p, phi_w, w_p, w_w, P)`` on the pinion
+and wheel nodes (``mesh_user_function``), ``+motor_torque_at(t, w_motor, D)`` on the motor node
 (``motor_user_function``) and ``-load_torque_at(t, D)`` on the machine node (``load_user_function``).
 The reported mesh force is ``mesh_contact_series(phi_p, r1 phi_p - r2 phi_w, r1 w_p - r2 w_w, P)`` of the
 dense-output states at the output times, as gearbody's own post-processing does.
