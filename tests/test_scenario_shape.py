@@ -175,3 +175,15 @@ def test_the_installed_layout_has_no_mapped_package_under_gearbody():
         for p in Path(gb.__file__).parent.rglob("__init__.py")
     }
     assert on_disk <= packages, f"packages missing from pyproject.toml: {sorted(on_disk - packages)}"
+
+
+def test_the_paper_reproduction_writes_into_the_checkout_it_runs_from(monkeypatch, tmp_path):
+    from pathlib import Path
+
+    from gearbody_validation.paper import common
+
+    checkout = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(checkout)
+    assert common._output_dir() == checkout / "validation" / "paper"
+    monkeypatch.chdir(tmp_path)  # elsewhere: beside the installed scripts
+    assert common._output_dir() == Path(common.__file__).resolve().parent
