@@ -252,7 +252,7 @@ class LabelledSpectrum:
 
     def plot(self, ax=None, title: str | None = None):
         """The spectrum with its labelled peaks (matplotlib axes; a new figure when ``ax`` is None)."""
-        from .analysis import plot_labelled_spectrum
+        from .plotting.spectrum import plot_labelled_spectrum
 
         unit = "rad/s^2" if self.signal.endswith("rad_s2") else "m/s^2"
         return plot_labelled_spectrum(

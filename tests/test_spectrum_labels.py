@@ -20,10 +20,10 @@ from gearbody.analysis.labels import (
     label_peaks,
     peaks_table,
     peaks_to_rows,
-    plot_labelled_spectrum,
     power_spectral_density,
 )
 from gearbody.analysis.spectrum import amplitude_spectrum
+from gearbody.plotting.spectrum import plot_labelled_spectrum
 
 # --- power spectral density -----------------------------------------------------------------------------
 

@@ -27,7 +27,7 @@ from gearbody.analysis.indicators import (
     sideband_energy_ratio,
 )
 from gearbody.analysis.kinematics import GearMesh, KinematicLine, KinematicSources, Shaft, kinematic_lines
-from gearbody.analysis.peak_report import peaks_table, peaks_to_rows, plot_labelled_spectrum
+from gearbody.analysis.peak_report import peaks_table, peaks_to_rows
 from gearbody.analysis.peaks import LabelledPeak, label_peaks
 from gearbody.analysis.psd import Psd, power_spectral_density
 from gearbody.analysis.spectrum import (
@@ -53,7 +53,6 @@ __all__ = [
     "label_peaks",
     "peaks_table",
     "peaks_to_rows",
-    "plot_labelled_spectrum",
     "power_spectral_density",
     "AngleDomainSignal",
     "ConditionIndicators",

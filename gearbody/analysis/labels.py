@@ -5,11 +5,10 @@ A drive is described by its shafts (rotation frequencies) and gear meshes (mesh 
 shafts each mesh couples), :class:`KinematicSources`. :func:`kinematic_lines` turns that into a catalogue
 of labelled frequencies; :func:`label_peaks` finds the prominent local maxima of an amplitude spectrum
 and names each one after the catalogue lines within a tolerance. Peaks that no line explains are kept
-with an empty label, so they stay visible. :func:`peaks_table`, :func:`peaks_to_rows` and
-:func:`plot_labelled_spectrum` present the result.
+with an empty label, so they stay visible. :func:`peaks_table` and :func:`peaks_to_rows`
+present the result; :func:`gearbody.plotting.spectrum.plot_labelled_spectrum` draws it.
 
-Engine-free: works on any uniformly sampled 1-D signal, simulated or measured. matplotlib is imported
-only inside :func:`plot_labelled_spectrum`.
+Engine-free and free of matplotlib: works on any uniformly sampled 1-D signal, simulated or measured.
 
 The code lives in :mod:`~gearbody.analysis.psd` (power spectral density),
 :mod:`~gearbody.analysis.kinematics` (shafts, meshes, line catalogue), :mod:`~gearbody.analysis.peaks`
@@ -25,7 +24,7 @@ from gearbody.analysis.kinematics import (
     Shaft,
     kinematic_lines,
 )
-from gearbody.analysis.peak_report import UNEXPLAINED, peaks_table, peaks_to_rows, plot_labelled_spectrum
+from gearbody.analysis.peak_report import UNEXPLAINED, peaks_table, peaks_to_rows
 from gearbody.analysis.peaks import LABEL_SEPARATOR, LabelledPeak, label_peaks
 from gearbody.analysis.psd import Psd, power_spectral_density
 
@@ -43,6 +42,5 @@ __all__ = [
     "label_peaks",
     "peaks_table",
     "peaks_to_rows",
-    "plot_labelled_spectrum",
     "power_spectral_density",
 ]

@@ -8,9 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gearbody.analysis.labels import plot_labelled_spectrum
-
 from .figure import new_figure
+from .spectrum import plot_labelled_spectrum
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -23,7 +22,7 @@ __all__ = ["kd_folded_figure", "labelled_spectrum_figure", "tsa_figure"]
 def labelled_spectrum_figure(
     spec: Spectrum, peaks: list[LabelledPeak], title: str, unit: str, f_max_hz: float
 ) -> Figure:
-    """The spectrum with its labelled peaks (:func:`gearbody.analysis.labels.plot_labelled_spectrum`)."""
+    """The spectrum with its labelled peaks (:func:`gearbody.plotting.spectrum.plot_labelled_spectrum`)."""
     fig = new_figure((1100, 500), 100)
     ax = fig.add_subplot(1, 1, 1)
     plot_labelled_spectrum(spec, peaks, ax=ax, title=title, unit=unit, f_max_hz=f_max_hz)

@@ -85,6 +85,24 @@ def _chunk(model, ta: float, tb: float, theta_a: float) -> dict:
     return {"ta": ta, "tb": tb, "sa": sa, "ss": ss, "la": la, "ls": ls, "theta_a": theta_a, "ws": ws}
 
 
+def phase_events(stage: int, n: int, k: int, mesh, ip: int) -> tuple[list, list]:
+    """The two terminal events that end the locked phase mode (n, k) of mesh ``stage`` of a chain whose
+    pinion angle is y[ip] (u = y[ip] z1 / 2 pi), with their mode changes (kind, stage, step)."""
+    cz = mesh.cz
+    lo = n + float(mesh.bA[k]) - _ETA_U
+    hi = n + float(mesh.bB[k]) + _ETA_U
+
+    def ev_up(t, y, ip=ip, cz=cz, hi=hi):
+        return y[ip] * cz - hi
+
+    def ev_down(t, y, ip=ip, cz=cz, lo=lo):
+        return y[ip] * cz - lo
+
+    ev_up.terminal, ev_up.direction = True, 1.0
+    ev_down.terminal, ev_down.direction = True, -1.0
+    return [ev_up, ev_down], [("phase", stage, +1), ("phase", stage, -1)]
+
+
 def _contact_edges(lu: float, c: int) -> list[tuple[float, float, int]]:
     """Dead-zone edges to watch from contact state c (1 drive flank, -1 back flank, 0 in the gap):
     (offset of d, crossing direction, contact state after the crossing), with hysteresis _ETA_D."""

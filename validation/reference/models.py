@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .integrate import _ETA_U, _chunk, _contact_edges
+from .integrate import _ETA_U, _chunk, _contact_edges, phase_events
 from .mesh import _Mesh
 from .modes import _mesh_force, _mode_error, _poly_eval
 from .scenario import design_shafts, stage_F_rated, stage_view, topology, train_stages
@@ -333,19 +333,9 @@ class _Train:
         for s, (n, k, c) in enumerate(modes):
             m = self.meshes[s]
             ip, iw, cz, r1, r2 = self.ip[s], self.iw[s], m.cz, m.r1, m.r2
-            lo = n + float(m.bA[k]) - _ETA_U
-            hi = n + float(m.bB[k]) + _ETA_U
-
-            def ev_up(t, y, ip=ip, cz=cz, hi=hi):
-                return y[ip] * cz - hi
-
-            def ev_down(t, y, ip=ip, cz=cz, lo=lo):
-                return y[ip] * cz - lo
-
-            ev_up.terminal, ev_up.direction = True, 1.0
-            ev_down.terminal, ev_down.direction = True, -1.0
-            events += [ev_up, ev_down]
-            actions += [("phase", s, +1), ("phase", s, -1)]
+            phase, phase_actions = phase_events(s, n, k, m, ip)
+            events += phase
+            actions += phase_actions
             if m.lu > 0.0:
                 for offset, direction, new_c in _contact_edges(m.lu, c):
 
