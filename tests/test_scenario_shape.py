@@ -43,13 +43,13 @@ def test_files_of_earlier_versions_with_meta_scene_still_load():
 @pytest.mark.parametrize(
     ("override", "instead"),
     [
-        ("production.error_mode.e_um=50", "design.stages.N.error_mode with N = 1..2"),
+        ("production.error_mode.e_um=50", "design.stages.N.error_mode.e_um with N = 1..2"),
         (
             'condition.damaged_teeth=[{gear="pinion",tooth=3,stiffness_factor=0.1}]',
             "design.stages.N.damaged_teeth",
         ),
-        ("design.mesh.backlash_um=5", "design.stages.N.mesh with N = 1..2"),
-        ("design.coupling.damping_Nms_per_rad=10", "design.shafts.N with N = 1..3"),
+        ("design.mesh.backlash_um=5", "design.stages.N.mesh.backlash_um with N = 1..2"),
+        ("design.coupling.damping_Nms_per_rad=10", "design.shafts.N.damping_Nms_per_rad with N = 1..3"),
     ],
 )
 def test_a_key_that_does_not_apply_to_a_train_is_refused_naming_what_to_write(override, instead):
@@ -187,3 +187,18 @@ def test_the_paper_reproduction_writes_into_the_checkout_it_runs_from(monkeypatc
     assert common._output_dir() == checkout / "validation" / "paper"
     monkeypatch.chdir(tmp_path)  # elsewhere: beside the installed scripts
     assert common._output_dir() == Path(common.__file__).resolve().parent
+
+
+def test_an_infeasible_drive_is_an_input_error_on_the_command_line(tmp_path, capsys):
+    from gearbody.cli import main
+
+    overload = [
+        "--set", 'operation.initial_state="steady"',
+        "--set", "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
+        "--set", "design.machine.rated_torque_Nm=6000",
+    ]
+    assert main(["run", "one-stage", *overload, "--t-end", "0.01", "--out", str(tmp_path), "--no-plots"]) == 2
+    assert "breakdown torque" in capsys.readouterr().err
+    assert main(["run", "two-stage", "--set", "production.error_mode.e_um=50", "--t-end", "0.01"]) == 2
+    assert "design.stages.N.error_mode.e_um with N = 1..2" in capsys.readouterr().err
+    assert not (tmp_path / "result.npz").exists()

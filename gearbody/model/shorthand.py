@@ -141,10 +141,11 @@ def _drop_empty(tables: dict[str, Any], trains_dump: bool) -> None:
             del table[key]
 
 
-def _canonical_hint(key: tuple[str, str], n_stages: Any) -> str:
+def _canonical_hint(key: tuple[str, str], n_stages: Any, rest: str = "") -> str:
+    """``design.stages.N.error_mode.e_um with N = 1..2``: what to write instead of a shorthand key."""
     if key in STAGE_KEYS:
-        return f"design.stages.N.{STAGE_KEYS[key]} with N = 1..{n_stages}"
-    return f"design.shafts.N with N = 1..{n_stages + 1 if isinstance(n_stages, int) else '?'}"
+        return f"design.stages.N.{STAGE_KEYS[key]}{rest} with N = 1..{n_stages}"
+    return f"design.shafts.N{rest} with N = 1..{n_stages + 1 if isinstance(n_stages, int) else '?'}"
 
 
 def _refuse_unknown(tables: dict[str, Any], source: str) -> None:
@@ -180,9 +181,10 @@ def translate_key(path: list[str], data: dict[str, Any]) -> tuple[list[str], dic
             "rigidly on the gears)"
         )
     if n != 1:
+        rest = "".join(f".{p}" for p in path[2:])
         raise ScenarioError(
             f"{dotted}: {_where(key)} does not apply to a drive of {n} stages; write "
-            f"{_canonical_hint(key, n)}" + (f".{'.'.join(path[2:])}" if path[2:] else "")
+            f"{_canonical_hint(key, n, rest)}"
         )
     if key in STAGE_KEYS:
         canonical = ["design", "stages", "1", STAGE_KEYS[key]]
