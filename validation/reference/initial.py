@@ -59,6 +59,23 @@ def initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     return q0, v0
 
 
+def chain_speeds(scenario: dict, pinion_torque_1: float, r_p: list, r_w: list, v0: np.ndarray) -> None:
+    """Steady speeds of a chain into v0[0 .. 2N+1]: the motor and pinion 1 on the Kloss stable branch at
+    pinion 1's torque, each wheel its pinion's speed times r_p / r_w, each next pinion the previous
+    wheel, the machine the last wheel (docs/scenario.md, "Gear trains", initial state "steady")."""
+    N = len(r_p)
+    motor = scenario["design"]["motor"]
+    wsr = float(motor["synchronous_speed_rad_s"])
+    ws0 = wsr * float(profile_value(0.0, scenario["operation"]["speed_profile"]))
+    w = ws0 - steady_slip(pinion_torque_1, motor) * wsr
+    v0[0] = w
+    for s in range(N):
+        v0[1 + 2 * s] = w
+        w = w * r_p[s] / r_w[s]
+        v0[2 + 2 * s] = w
+    v0[2 * N + 1] = w
+
+
 def _train_initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     """Initial state of a train (section "Gear trains" of docs/scenario.md), stage by stage."""
     stages = train_stages(scenario)
@@ -83,16 +100,7 @@ def _train_initial_state(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
         F = [load0 * Fr for Fr in stage_F_rated(scenario)]  # F_s = f F_rated,s
     pinion_torque = [F[s] * r_p[s] for s in range(N)]
     # speeds: motor = pinion 1 from the Kloss stable branch, wheel = pinion r_p / r_w, next pinion = wheel
-    motor = d_["motor"]
-    wsr = float(motor["synchronous_speed_rad_s"])
-    ws0 = wsr * float(profile_value(0.0, scenario["operation"]["speed_profile"]))
-    w = ws0 - steady_slip(pinion_torque[0], motor) * wsr
-    v0[0] = w
-    for s in range(N):
-        v0[1 + 2 * s] = w
-        w = w * r_p[s] / r_w[s]
-        v0[2 + 2 * s] = w
-    v0[2 * N + 1] = w
+    chain_speeds(scenario, pinion_torque[0], r_p, r_w, v0)
     # angles: pinion 1 = 0, then stage by stage in power-flow order
     pinion = 0.0
     for s in range(N):

@@ -57,11 +57,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from .initial import chain_speeds
 from .integrate import _output_times, integrate
 from .lateral_model import _LatTrain
 from .lateral_scenario import static_displacement
 from .law import effective_stiffness, total_error
-from .scenario import TWO_PI, profile_value, stage_view, steady_slip, train_stages
+from .scenario import TWO_PI, profile_value, stage_view, train_stages
 
 
 def initial_state_lateral(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -86,16 +87,7 @@ def initial_state_lateral(scenario: dict) -> tuple[np.ndarray, np.ndarray]:
     z_p = [int(st["pinion"]["teeth"]) for st in stages]
     F = [load0 * Fr for Fr in model.Frated]
     pinion_torque = [F[s] * r_p[s] for s in range(N)]
-    motor = d_["motor"]
-    wsr = float(motor["synchronous_speed_rad_s"])
-    ws0 = wsr * float(profile_value(0.0, sc["operation"]["speed_profile"]))
-    w = ws0 - steady_slip(pinion_torque[0], motor) * wsr
-    v0[0] = w
-    for s in range(N):
-        v0[1 + 2 * s] = w
-        w = w * r_p[s] / r_w[s]
-        v0[2 + 2 * s] = w
-    v0[2 * N + 1] = w
+    chain_speeds(sc, pinion_torque[0], r_p, r_w, v0)
     pinion = 0.0
     for s in range(N):
         view = stage_view(sc, s)
