@@ -55,3 +55,12 @@ def test_validate_command_prints_a_table_and_reports_failure(capsys):
     assert run_validation(["two-wheel"], short=True, echo=lines.append)
     assert any(line.split()[:2] == ["two-wheel", "steady"] for line in lines)
     assert not run_validation(["two-wheel"], short=True, tolerance_percent=1e-9, echo=lines.append)
+
+
+@pytest.mark.parametrize("case", ["separation", "run-up"])
+def test_muller_full_length_cases_pass_at_the_default_tolerance(case):
+    """Issue 16: at atol 1e-8 m (the rotations' 1e-8 rad taken for metres) Muller's full separation and
+    run-up missed by 0.66 % and 10.3 %; its own default (3e-11 m of deflection) passes with margin."""
+    c = {c.name: c for c in cases("muller")}[case]
+    result = compare_case("muller", c, short=False)
+    assert result.passed and result.max_error_percent < 0.1, result

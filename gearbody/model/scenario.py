@@ -85,17 +85,26 @@ class Condition(Node):
 SOLVER_METHODS = ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")
 
 
+DEFAULT_ABSOLUTE_TOLERANCE = {"train": 1e-8, "two-wheel": 1e-8, "muller": 3e-11}
+"""Default absolute tolerance per topology, in the units of its coordinates. Trains and two-wheel integrate
+rotations (rad): 1e-8 rad is r_b 1e-8 ~ 1e-9 m of mesh deflection, and meets 0.5 % of F_rated on every
+validation case with a 10x margin. Muller's one coordinate is the deflection itself (m): at 1e-8 m its full
+separation and run-up cases miss by 0.66 % and 10.3 % (the re-engagement impacts of the load ramp);
+3e-11 m gives 0.0001 % and 0.031 % (1e-9: 0.0016 / 2.1 %, 1e-10: 0.0001 / 0.21 %)."""
+
+
 @dataclass(frozen=True, kw_only=True)
 class Solver(Node):
     method: str = param("DOPRI5", choices=SOLVER_METHODS, doc="Exudyn explicit integrator")
     # The mesh force depends on r1 phi_p - r2 phi_w, a small difference of angles that grow past
     # 100 rad per simulated second. Exudyn scales each coordinate's error by atol + rtol * max(q0, q1)
     # (signed), so a relative tolerance loosens as the angles grow: rtol is kept negligible and the
-    # absolute tolerance (SI units: rad, rad/s, m, m/s) sets the accuracy. atol 1e-8 meets the 0.5 %
-    # validation tolerance on every case with a 10x margin (1e-7 fails the impacts of the Muller and
-    # two-stage separation cases); docs/design-notes.md, "Solver tolerances".
+    # absolute tolerance (SI units: rad, rad/s, m, m/s) sets the accuracy, so its default depends on what
+    # the coordinates are (DEFAULT_ABSOLUTE_TOLERANCE); docs/design-notes.md, "Solver tolerances".
     relative_tolerance: float = param(1e-14, gt=0, lt=1, doc="adaptive step relative tolerance")
-    absolute_tolerance: float = param(1e-8, gt=0, doc="adaptive step absolute tolerance")
+    absolute_tolerance: float | None = param(
+        None, gt=0, doc="adaptive step absolute tolerance (unset: by topology, DEFAULT_ABSOLUTE_TOLERANCE)"
+    )
     max_step_s: float = param(1e-4, gt=0, doc="largest step")
     output_rate_hz: float = param(20000.0, gt=0, doc="results are sampled at k / output_rate_hz")
     # The mesh force jumps when the pair count changes; point samples of it alias (its 1/k harmonics
@@ -131,12 +140,22 @@ class Scenario(Node):
         if "design" in fields:
             _check_topology(fields["meta"].topology, fields["design"])
             fields = {**fields, "design": resolve_design(fields["design"])}
+        solver = fields.get("solver", Solver())
+        if solver.absolute_tolerance is None:  # the default of this topology's coordinates
+            atol = DEFAULT_ABSOLUTE_TOLERANCE[fields["meta"].topology]
+            fields = {**fields, "solver": dataclasses.replace(solver, absolute_tolerance=atol)}
         return fields
+
+    @classmethod
+    def create(cls, **fields: Any) -> Scenario:
+        """A Scenario from its sections (Meta, Design, Operation, ...), with gear geometry and the solver
+        defaults resolved (``Scenario(...)`` itself expects them resolved)."""
+        return cls(**cls.prepare_fields(fields))
 
     def replace(self, **changes: Any) -> Scenario:
         """A copy with whole sections replaced (``operation=steady(0.3)``), resolved and validated."""
         fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        return Scenario(**Scenario.prepare_fields({**fields, **changes}))
+        return Scenario.create(**{**fields, **changes})
 
     def with_stage(self, stage: int, **changes: Any) -> Scenario:
         """A copy with fields of stage ``stage`` (0-based) replaced, e.g.
@@ -150,6 +169,11 @@ class Scenario(Node):
         return self.replace(design=self.design.replace(stages=tuple(stages)))
 
     def __post_init__(self) -> None:
+        if self.solver.absolute_tolerance is None:
+            raise ScenarioError(
+                "solver.absolute_tolerance is unset: build a Scenario with load_scenario(...) or "
+                "Scenario.create(...), which resolve the defaults"
+            )
         _check_topology(self.meta.topology, self.design)
         for k, stage in enumerate(self.stages):
             _check_stage(k, stage)
