@@ -107,3 +107,23 @@ def test_steady_start_subtracts_the_error_in_mesh(steady):
     )
     r = simulate(sc)
     assert abs(r.kd[0] - 1.0) < 1e-9
+
+
+def test_the_watchdog_reports_divergence_and_stalls_with_their_time():
+    """No pre-step Python call per step attempt: the force function's watchdog checks every few thousand
+    calls for a non-finite or runaway speed, and for time that stopped advancing."""
+    from gearbody.engine.user_functions import CHECK_CALLS, STALL_CALLS, StallError, StallWatchdog
+
+    dog = StallWatchdog()
+    dog.watch(1.0, 1e3, False, "motor speed", "rad/s")
+    for k in range(CHECK_CALLS - 1):
+        dog(1e-3 * k, float("nan"))  # between checks: no cost, no verdict
+    with pytest.raises(StallError, match=r"diverged at t = .*motor speed nan rad/s"):
+        dog(0.5, float("nan"))
+    assert "diverged" in dog.failure
+    dog = StallWatchdog()
+    dog.watch(1.0, 1e3, False, "motor speed", "rad/s")
+    with pytest.raises(StallError, match=r"stalled at t = 0\.25"):
+        for _ in range(2 * STALL_CALLS):
+            dog(0.25, 100.0)
+    assert dog.calls == 2 * STALL_CALLS  # the first check sets the mark, the second finds no progress

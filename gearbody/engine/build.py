@@ -50,6 +50,7 @@ from ..physics.mesh import mesh_contact, single_mesh_drive_forces, torsional_mes
 from .user_functions import (
     StallWatchdog,
     bearing_user_function,
+    compiled,
     lateral_mesh_user_function,
     load_user_function,
     mesh_user_function,
@@ -311,10 +312,15 @@ def build_muller(scenario: Scenario, q0, v0, *, sensors: bool = True) -> BuiltSy
     P = mesh_parameters_from_scenario(scenario, friction=False)
     D = pack_drive_parameters(scenario)
     F_rated = scenario.rated_mesh_force_N
+    watchdog = built.watchdog
+    contact = compiled(mesh_contact, 0.0, 0.0, 0.0, P)
+    angle = compiled(synchronous_angle_at, 0.0, D)
+    load = compiled(load_fraction_at, 0.0, D)
 
     def muller_force(mbs, t, itemNumber, q, q_t):
-        F = mesh_contact(synchronous_angle_at(t, D), q[0], q_t[0], P)[0]
-        return [F_rated * load_fraction_at(t, D) - F]
+        watchdog(t, q_t[0])
+        F = contact(angle(t, D), q[0], q_t[0], P)[0]
+        return [F_rated * load(t, D) - F]
 
     built.user_functions.append(muller_force)
     mbs.AddObject(
@@ -343,24 +349,28 @@ def _add_drive_and_meshes(built: BuiltSystem, layout: TorsionalLayout) -> None:
         m = layout.meshes[0]
         order = [layout.motor_at, m.pinion, m.wheel, layout.load_at]
         P = m.parameters
+        forces = compiled(single_mesh_drive_forces, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, P, D)
 
         def drive_and_mesh(mbs, t, itemNumber, q, q_t):
-            watchdog(t)
-            return single_mesh_drive_forces(t, q_t[0], q[1], q[2], q_t[1], q_t[2], P, D)
+            watchdog(t, q_t[0])
+            return forces(t, q_t[0], q[1], q[2], q_t[1], q_t[2], P, D)
 
         function = drive_and_mesh
     else:
         order = list(range(len(layout.inertias)))
         n, im, il = len(order), layout.motor_at, layout.load_at
         meshes = [(m.pinion, m.wheel, m.parameters) for m in layout.meshes]
+        motor = compiled(motor_torque_at, 0.0, 0.0, D)
+        load = compiled(load_torque_at, 0.0, D)
+        mesh_forces = compiled(torsional_mesh_forces, 0.0, 0.0, 0.0, 0.0, meshes[0][2])
 
         def drive_and_meshes(mbs, t, itemNumber, q, q_t):
-            watchdog(t)
+            watchdog(t, q_t[im])
             f = [0.0] * n
-            f[im] = motor_torque_at(t, q_t[im], D)
-            f[il] -= load_torque_at(t, D)
+            f[im] = motor(t, q_t[im], D)
+            f[il] -= load(t, D)
             for ip, iw, P in meshes:
-                a, b = torsional_mesh_forces(q[ip], q[iw], q_t[ip], q_t[iw], P)
+                a, b = mesh_forces(q[ip], q[iw], q_t[ip], q_t[iw], P)
                 f[ip] += a
                 f[iw] += b
             return f

@@ -5,6 +5,10 @@ millions of times per simulated second: keep these thin)."""
 
 from __future__ import annotations
 
+import math
+import time
+
+import numba
 import numpy as np
 
 from ..assembly import Inertia
@@ -13,9 +17,20 @@ from ..physics.lateral import lateral_mesh_forces
 from ..physics.mesh import torsional_mesh_forces
 
 
+def compiled(dispatcher, *example_args):
+    """The machine-code entry point of a numba function for the argument types of ``example_args``
+    (compiled, or loaded from numba's cache, on first use): calling it skips numba's per-call type
+    dispatch, ~0.15 of ~0.6 us per call of the drive's force law (benchmarks/RESULTS.md)."""
+    dispatcher(*example_args)
+    signature = tuple(numba.typeof(a) for a in example_args)
+    return dispatcher.overloads[signature].entry_point
+
+
 def mesh_user_function(P: np.ndarray):
+    forces = compiled(torsional_mesh_forces, 0.0, 0.0, 0.0, 0.0, P)
+
     def mesh_force(mbs, t, itemNumber, q, q_t):
-        return torsional_mesh_forces(q[0], q[1], q_t[0], q_t[1], P)
+        return forces(q[0], q[1], q_t[0], q_t[1], P)
 
     return mesh_force
 
@@ -24,9 +39,11 @@ def lateral_mesh_user_function(m, bp: Inertia, bw: Inertia, idx: np.ndarray):
     free = [float(d in b.lateral.free_directions) if b.lateral else 0.0 for b in (bp, bw) for d in (0, 1)]
     geometry = np.array([*m.line_of_action, *m.friction_direction, *free])
     P = m.parameters
+    zeros = np.zeros(int(idx.max()) + 1)
+    forces = compiled(lateral_mesh_forces, zeros, zeros, idx, geometry, P)
 
     def lateral_mesh_force(mbs, t, itemNumber, q, q_t):
-        return lateral_mesh_forces(np.asarray(q), np.asarray(q_t), idx, geometry, P)
+        return forces(np.asarray(q), np.asarray(q_t), idx, geometry, P)
 
     return lateral_mesh_force
 
@@ -51,26 +68,52 @@ def bearing_user_function(law, free_directions: tuple[int, ...]):
 
 
 class StallError(RuntimeError):
-    """Raised from inside a user function when the solver makes no progress in time (Exudyn passes it on
-    as its own error; the watchdog's ``failure`` tells the caller what happened)."""
+    """Raised from inside a user function when the run stalls or diverges (Exudyn passes it on as its own
+    error; the watchdog's ``failure`` tells the caller what happened)."""
 
 
-STALL_CALLS = 200_000  # right-hand-side evaluations per check (~30k steps: ~0.1 s simulated normally)
+CHECK_CALLS = 2_000  # force evaluations between divergence checks and progress updates (~250 attempts)
+STALL_CALLS = 200_000  # force evaluations per stall check (~30k steps: ~0.1 s simulated normally)
 STALL_ADVANCE_S = 1e-9
 
 
 class StallWatchdog:
-    """Called with t on every force evaluation: Exudyn's step control can reject steps at the minimum step
-    size forever (no pre-step call happens then), but every attempt evaluates the drive's forces."""
+    """Rides on the drive's force function, which every step attempt evaluates (no pre-step Python call
+    per attempt): every CHECK_CALLS calls it checks the watched speed for divergence and draws the
+    progress bar; every STALL_CALLS calls it checks that time advanced (Exudyn's step control can reject
+    steps at the minimum step size forever)."""
 
     def __init__(self) -> None:
         self.calls, self.t_check, self.t_max = 0, -1.0, -1.0
         self.failure = ""
+        self.speed_limit = math.inf
+        self.speed_name, self.speed_unit = "motor speed", "rad/s"
+        self.t_end = 0.0
+        self.progress = False
+        self.bar = None
+        self.t_wall0 = self.last_draw = 0.0
 
-    def __call__(self, t: float) -> None:
+    def watch(self, t_end: float, speed_limit: float, progress: bool, name: str, unit: str) -> None:
+        """Set what the run watches: divergence above ``speed_limit`` of the watched speed, a progress bar."""
+        self.t_end, self.speed_limit, self.progress = t_end, speed_limit, progress
+        self.speed_name, self.speed_unit = name, unit
+        self.t_wall0 = time.monotonic()
+
+    def __call__(self, t: float, speed: float) -> None:
         self.calls += 1
         if t > self.t_max:
             self.t_max = t
+        if self.calls % CHECK_CALLS == 0:
+            self._check(t, speed)
+
+    def _check(self, t: float, speed: float) -> None:
+        if not math.isfinite(speed) or abs(speed) > self.speed_limit:
+            self.failure = (
+                f"state diverged at t = {t:.6g} s ({self.speed_name} {speed:.3g} {self.speed_unit}). Hint: "
+                "check stiffness, inertia and load values, or tighten solver tolerances / lower "
+                "solver.max_step_s"
+            )
+            raise StallError(self.failure)
         if self.calls % STALL_CALLS == 0:
             if self.t_max - self.t_check < STALL_ADVANCE_S:
                 self.failure = (
@@ -81,20 +124,44 @@ class StallWatchdog:
                 )
                 raise StallError(self.failure)
             self.t_check = self.t_max
+        if self.progress:
+            now = time.monotonic()
+            if self.bar is None and now - self.t_wall0 > 2.0:
+                from tqdm import tqdm
+
+                self.bar = tqdm(
+                    total=round(self.t_end, 6),
+                    unit="s sim",
+                    desc="simulating",
+                    bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s sim [{elapsed}<{remaining}]",
+                )
+            if self.bar is not None and now - self.last_draw > 0.5:
+                self.last_draw = now
+                self.bar.n = round(self.t_max, 6)
+                self.bar.refresh()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.n = self.bar.total
+            self.bar.close()
+            self.bar = None
 
 
 def motor_user_function(D: np.ndarray, watchdog: StallWatchdog):
-    """Motor torque (and the stall watchdog)."""
+    """Motor torque (and the run's watchdog)."""
+    torque = compiled(motor_torque_at, 0.0, 0.0, D)
 
     def motor_torque(mbs, t, itemNumber, q, q_t):
-        watchdog(t)
-        return (motor_torque_at(t, q_t[0], D),)
+        watchdog(t, q_t[0])
+        return (torque(t, q_t[0], D),)
 
     return motor_torque
 
 
 def load_user_function(D: np.ndarray):
+    torque = compiled(load_torque_at, 0.0, D)
+
     def load_torque(mbs, t, itemNumber, q, q_t):
-        return (-load_torque_at(t, D),)
+        return (-torque(t, D),)
 
     return load_torque
