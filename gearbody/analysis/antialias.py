@@ -20,7 +20,6 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
-from scipy.signal import oaconvolve
 
 __all__ = ["KERNEL_HALF_WIDTH_SAMPLES", "band_limited_samples", "level_crossings"]
 
@@ -135,6 +134,8 @@ def band_limited_samples(
     L = KERNEL_HALF_WIDTH_SAMPLES * M
     taps, s_tau, s_cum = _filter_tables(rate, M, stopband_db)
     padded = np.pad(rest, L, mode="reflect", reflect_type="odd")
+    from scipy.signal import oaconvolve  # ~0.4 s to import: only when a run is band-limited
+
     y = oaconvolve(padded, taps, mode="valid")[::M]
 
     # 4. Add the filtered steps: dx * S(t_k - t_jump), S the kernel's step response.

@@ -10,8 +10,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import median_filter
-from scipy.signal import find_peaks
 
 from gearbody.analysis._validate import integer_at_least, is_real, positive_frequency
 from gearbody.analysis.kinematics import KinematicLine
@@ -102,6 +100,9 @@ def label_peaks(
     for i, line in enumerate(lines):
         if not isinstance(line, KinematicLine):
             raise ValueError(f"lines[{i}] must be a KinematicLine, got {type(line).__name__}")
+
+    from scipy.ndimage import median_filter  # scipy.signal/ndimage: ~0.5 s to import, on use only
+    from scipy.signal import find_peaks
 
     floor = median_filter(a, size=2 * floor_bins + 1, mode="reflect")
     index, _ = find_peaks(a, height=floor * 10.0 ** (min_prominence_db / 20.0))

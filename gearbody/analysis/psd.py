@@ -11,7 +11,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import welch
 
 from gearbody.analysis._validate import is_real, positive_frequency
 
@@ -106,6 +105,8 @@ def power_spectral_density(
     if not (detrend is False or detrend in ("constant", "linear")):
         raise ValueError(f"detrend must be a bool, 'constant' or 'linear', got {detrend!r}")
     noverlap = nperseg // 2
+    from scipy.signal import welch  # ~0.4 s to import: on use only
+
     frequency_hz, psd = welch(
         x,
         fs=sample_rate_hz,

@@ -10,8 +10,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import detrend as _detrend
-from scipy.signal import get_window
 
 __all__ = [
     "Peak",
@@ -82,8 +80,12 @@ def amplitude_spectrum(
     if detrend:
         if detrend not in ("constant", "linear"):
             raise ValueError(f"detrend must be a bool, 'constant' or 'linear', got {detrend!r}")
+        from scipy.signal import detrend as _detrend  # ~0.4 s to import: on use only
+
         x = _detrend(x, type=detrend)
     n = x.size
+    from scipy.signal import get_window
+
     w = get_window(window, n, fftbins=True)
     spectrum = np.abs(np.fft.rfft(x * w)) / np.sum(w)
     spectrum[1:] *= 2.0
