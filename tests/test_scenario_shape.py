@@ -202,3 +202,19 @@ def test_an_infeasible_drive_is_an_input_error_on_the_command_line(tmp_path, cap
     assert main(["run", "two-stage", "--set", "production.error_mode.e_um=50", "--t-end", "0.01"]) == 2
     assert "design.stages.N.error_mode.e_um with N = 1..2" in capsys.readouterr().err
     assert not (tmp_path / "result.npz").exists()
+
+
+def test_accuracy_levels_set_method_and_tolerance_in_the_coordinates_units():
+    def solver(scene, *overrides):
+        s = load_scenario(scene, list(overrides)).solver
+        return s.method, s.absolute_tolerance
+
+    assert solver("one-stage") == ("DOPRI5", 1e-8)
+    assert solver("muller") == ("DOPRI5", pytest.approx(3e-11))  # a deflection in m, not an angle
+    assert solver("two-stage", 'solver.accuracy="draft"') == ("ODE23", 3e-5)
+    assert solver("one-stage", 'solver.accuracy="tight"') == ("DOPRI5", 1e-10)
+    assert solver("one-stage", 'solver.accuracy="draft"', "solver.absolute_tolerance=1e-6") == ("ODE23", 1e-6)
+    with pytest.raises(ScenarioError, match="solver.accuracy = 'fast': must be one of 'draft', 'default'"):
+        load_scenario("one-stage", ['solver.accuracy="fast"'])
+    sc = load_scenario("one-stage", ['solver.accuracy="draft"'])
+    assert load_scenario(scenario_to_dict(sc)) == sc  # the resolved method and tolerance are written out
