@@ -20,6 +20,7 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 __all__ = ["KERNEL_HALF_WIDTH_SAMPLES", "band_limited_samples", "level_crossings"]
 
@@ -134,9 +135,9 @@ def band_limited_samples(
     L = KERNEL_HALF_WIDTH_SAMPLES * M
     taps, s_tau, s_cum = _filter_tables(rate, M, stopband_db)
     padded = np.pad(rest, L, mode="reflect", reflect_type="odd")
-    from scipy.signal import oaconvolve  # ~0.4 s to import: only when a run is band-limited
-
-    y = oaconvolve(padded, taps, mode="valid")[::M]
+    # only every M-th output is kept: a strided dot product computes just those (as fast as an FFT
+    # convolution of the whole fine grid, exact to round-off, and no scipy.signal import, ~0.6 s)
+    y = sliding_window_view(padded, taps.size)[::M] @ taps[::-1]
 
     # 4. Add the filtered steps: dx * S(t_k - t_jump), S the kernel's step response.
     t_out = t[::M]
