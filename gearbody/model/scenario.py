@@ -89,8 +89,8 @@ ACCURACY_LEVELS = {
     # level: (method, absolute tolerance of rotations in rad); Muller's deflection coordinate (m) gets
     # MULLER_TOLERANCE_SCALE times it. Measured against the independent reference on the full validation
     # cases (benchmarks/RESULTS.md, "Accuracy levels").
-    "draft": ("ODE23", 3e-5),  # steady, loaded running (studies of error modes, faults): <= 0.15 %; misses
-    #                            impacts (separation cases 1-12 %): not for K_d > 2
+    "draft": ("ODE23", 3e-5),  # loaded steady running, torsional studies of error modes and faults:
+    #                            0.15-0.26 %; misses impacts (1-35 % on separations) and bearing forces
     "default": ("DOPRI5", 1e-8),  # every validation case <= 0.05 %, impacts included
     "tight": ("DOPRI5", 1e-10),  # a yardstick: ~1e-4 % of F_rated
 }
