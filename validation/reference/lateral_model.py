@@ -17,7 +17,7 @@ from .integrate import _chunk, _contact_edges, phase_events
 from .lateral_scenario import _AXES, as_train, gear_names, mesh_geometry, resolve_lateral_defaults
 from .mesh import _Mesh
 from .modes import _mesh_force, _mode_error, _mode_mu_sign, _poly_eval
-from .scenario import stage_F_rated, stage_view, train_stages
+from .scenario import chain_constants, stage_F_rated, stage_view, train_stages
 
 _ETA_R = 1e-15  # event hysteresis on r - c (m)
 _ETA_F = 1e-9  # event hysteresis on the hertzian radial force f_r (N)
@@ -101,19 +101,9 @@ class _LatTrain:
             self.stage_gears.append(tuple(pair))
         self.n_dof = nxt
         self.hertz = [g for g in self.gears if g.kind == "hertzian"]
-        d_ = sc["design"]
-        self.shaft_k = [float(sh["stiffness_Nm_per_rad"]) for sh in d_["shafts"]]
-        self.shaft_C = [float(sh["damping_Nms_per_rad"]) for sh in d_["shafts"]]
-        mot = d_["motor"]
-        self.wsr = float(mot["synchronous_speed_rad_s"])
-        self.Mb = float(mot["breakdown_torque_Nm"])
-        self.sb = float(mot["breakdown_slip"])
-        inertia = [float(mot["inertia_kg_m2"])]
-        for st in stages:
-            inertia += [float(st["pinion"]["inertia_kg_m2"]), float(st["wheel"]["inertia_kg_m2"])]
-        inertia.append(float(d_["machine"]["inertia_kg_m2"]))
-        self.inertia = inertia
-        self.Mrated = float(d_["machine"]["rated_torque_Nm"])
+        (self.shaft_k, self.shaft_C, self.wsr, self.Mb, self.sb, self.inertia, self.Mrated) = chain_constants(
+            sc, stages
+        )
         op = sc["operation"]
         self.speed_prof = op["speed_profile"]
         self.load_prof = op["load_profile"]

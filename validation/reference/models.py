@@ -12,7 +12,7 @@ import numpy as np
 from .integrate import _ETA_U, _chunk, _contact_edges, phase_events
 from .mesh import _Mesh
 from .modes import _mesh_force, _mode_error, _poly_eval
-from .scenario import design_shafts, stage_F_rated, stage_view, topology, train_stages
+from .scenario import chain_constants, stage_F_rated, stage_view, topology, train_stages
 
 
 class _SingleMesh(_Mesh):
@@ -210,19 +210,9 @@ class _Train:
         self.meshes = [_Mesh(stage_view(sc, s), Fr) for s, Fr in enumerate(stage_F_rated(sc))]
         self.ip = [1 + 2 * s for s in range(self.N)]
         self.iw = [2 + 2 * s for s in range(self.N)]
-        d_ = sc["design"]
-        self.shaft_k = [float(sh["stiffness_Nm_per_rad"]) for sh in design_shafts(sc)]
-        self.shaft_C = [float(sh.get("damping_Nms_per_rad", 0.0)) for sh in design_shafts(sc)]
-        mot = d_["motor"]
-        self.wsr = float(mot["synchronous_speed_rad_s"])
-        self.Mb = float(mot["breakdown_torque_Nm"])
-        self.sb = float(mot["breakdown_slip"])
-        inertia = [float(mot["inertia_kg_m2"])]
-        for st in stages:
-            inertia += [float(st["pinion"]["inertia_kg_m2"]), float(st["wheel"]["inertia_kg_m2"])]
-        inertia.append(float(d_["machine"]["inertia_kg_m2"]))
-        self.inertia = inertia
-        self.Mrated = float(d_["machine"]["rated_torque_Nm"])
+        (self.shaft_k, self.shaft_C, self.wsr, self.Mb, self.sb, self.inertia, self.Mrated) = chain_constants(
+            sc, stages
+        )
         self.Frated = np.array([m.Frated for m in self.meshes])
         op = sc["operation"]
         self.speed_prof = op["speed_profile"]

@@ -99,6 +99,27 @@ def design_shafts(scenario: dict) -> list[dict]:
     return []
 
 
+def chain_constants(scenario: dict, stages: list[dict]):
+    """(shaft stiffnesses, shaft dampings, rated synchronous speed, M_b, s_b, inertias of [motor, pinion 1,
+    wheel 1, ..., machine], rated machine torque) of a chain, as the train models use them."""
+    d = scenario["design"]
+    shafts = design_shafts(scenario)
+    motor = d["motor"]
+    inertia = [float(motor["inertia_kg_m2"])]
+    for st in stages:
+        inertia += [float(st["pinion"]["inertia_kg_m2"]), float(st["wheel"]["inertia_kg_m2"])]
+    inertia.append(float(d["machine"]["inertia_kg_m2"]))
+    return (
+        [float(sh["stiffness_Nm_per_rad"]) for sh in shafts],
+        [float(sh.get("damping_Nms_per_rad", 0.0)) for sh in shafts],
+        float(motor["synchronous_speed_rad_s"]),
+        float(motor["breakdown_torque_Nm"]),
+        float(motor["breakdown_slip"]),
+        inertia,
+        float(d["machine"]["rated_torque_Nm"]),
+    )
+
+
 def train_stages(scenario: dict) -> list[dict]:
     """design.stages of a train, checked: N >= 1 stages and exactly N + 1 shafts."""
     stages = design_stages(scenario)
