@@ -72,8 +72,12 @@ def _job(kind: str, scene: str, t_end: float, extra: list[str], arg: float | Non
         wall = time.perf_counter() - t0
         st = r.meta["solver_statistics"]
         out = (wall, st["steps"], st["rejected_steps"], r.time_s, r.mesh_force)
-    elif kind == "floor":  # the same Exudyn system with no user function: constant mesh stiffness
+    elif kind in ("floor", "python-floor"):  # the same system, constant mesh stiffness, no force law
+        # python-floor: plus one Python user function on every node that returns zeros, the cost of
+        # Exudyn calling Python once per right-hand side (what gearbody's one force function costs
+        # before it computes anything)
         import exudyn as exu
+        import exudyn.solver
 
         from gearbody.assembly import static_lateral_displacements_m, torsional_layout
         from gearbody.engine.build import build_torsional
@@ -83,7 +87,21 @@ def _job(kind: str, scene: str, t_end: float, extra: list[str], arg: float | Non
         layout = torsional_layout(sc)
         built = build_torsional(layout, q0, v0, modal_mesh_stiffness_N_per_m=[1.25e9] * len(layout.meshes),
                                 lateral_u0=static_lateral_displacements_m(sc), sensors=True)
+        if kind == "python-floor":
+            from exudyn.itemInterface import ObjectGenericODE2
+
+            size = len(built.dof_names)
+            zeros = [0.0] * size
+
+            def no_force(mbs, t, itemNumber, q, q_t):
+                return zeros
+
+            built.user_functions.append(no_force)
+            built.mbs.AddObject(ObjectGenericODE2(nodeNumbers=built.nodes, massMatrix=np.zeros((size, size)),
+                                                  forceUserFunction=no_force))
+            built.mbs.Assemble()
         settings = solver_settings(sc)
+        exudyn.solver.solverCheckMemoryAllocationsThreshold = 2**62  # the zeros list is Python's
         t0 = time.perf_counter()
         exu.SolveDynamic(built.mbs, settings, solverType=SOLVER_TYPES[sc.solver.method], storeSolver=True,
                          showHints=False)
@@ -152,6 +170,11 @@ def bench_scene(scene: str, t_end: float) -> list[str]:
         "Exudyn floor: the same system, no user function (constant mesh stiffness, no motor/load law)",
         run_fresh("floor", scene, t_end),
         "what Exudyn costs without gearbody's Python force function",
+    )
+    row(
+        "Exudyn floor + one Python user function returning zeros (the same system)",
+        run_fresh("python-floor", scene, t_end),
+        "the cost of one Python call per right-hand side, before any force is computed",
     )
     ref_s, _ = row("scipy reference (validation/)", run_fresh("reference", scene, t_end))
     numba_s = None

@@ -127,3 +127,47 @@ def test_the_watchdog_reports_divergence_and_stalls_with_their_time():
         for _ in range(2 * STALL_CALLS):
             dog(0.25, 100.0)
     assert dog.calls == 2 * STALL_CALLS  # the first check sets the mark, the second finds no progress
+
+
+def test_the_watchdog_ticker_checks_like_a_call_per_evaluation():
+    """The force functions use ``tick, check = watchdog.ticker()``: the same verdicts, counted the same."""
+    from gearbody.engine.user_functions import CHECK_CALLS, STALL_CALLS, StallError, StallWatchdog
+
+    dog = StallWatchdog()
+    dog.watch(1.0, 1e3, False, "motor speed", "rad/s")
+    tick, check = dog.ticker()
+    assert [tick() for _ in range(CHECK_CALLS)].count(True) == 1
+    dog = StallWatchdog()
+    dog.watch(1.0, 1e3, False, "motor speed", "rad/s")
+    tick, check = dog.ticker()
+    with pytest.raises(StallError, match=r"diverged at t = 0\.5 s .*motor speed 2e\+03 rad/s"):
+        for k in range(10 * CHECK_CALLS):
+            if tick():
+                check(0.5, 100.0 if k < 5 * CHECK_CALLS else 2e3)
+    assert dog.calls == 6 * CHECK_CALLS
+    dog = StallWatchdog()
+    dog.watch(1.0, 1e3, False, "motor speed", "rad/s")
+    tick, check = dog.ticker()
+    with pytest.raises(StallError, match=r"stalled at t = 0\.25"):
+        for _ in range(2 * STALL_CALLS):
+            if tick():
+                check(0.25, 100.0)
+    assert dog.calls == 2 * STALL_CALLS
+
+
+def test_cubic_hermite_is_scipys_spline_bit_for_bit():
+    """collect() resamples with engine.sampling.CubicHermite instead of importing scipy.interpolate:
+    the same values to the last bit, at, between and beyond the step times."""
+    from scipy.interpolate import CubicHermiteSpline
+
+    from gearbody.engine.sampling import CubicHermite
+
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        n, m = int(rng.integers(2, 200)), int(rng.integers(1, 5))
+        x = np.cumsum(rng.uniform(1e-7, 1e-3, n))
+        y = rng.normal(size=(m, n)) * 10 ** rng.uniform(-6, 3)
+        dydx = rng.normal(size=(m, n)) * 1e3
+        times = np.concatenate([np.linspace(x[0] - 1e-4, x[-1] + 1e-4, 300), x, rng.uniform(x[0], x[-1], 50)])
+        expected = CubicHermiteSpline(x, y, dydx, axis=1)(times)
+        assert np.array_equal(CubicHermite(x, y, dydx)(times), expected)

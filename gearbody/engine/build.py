@@ -317,8 +317,11 @@ def build_muller(scenario: Scenario, q0, v0, *, sensors: bool = True) -> BuiltSy
     angle = compiled(synchronous_angle_at, 0.0, D)
     load = compiled(load_fraction_at, 0.0, D)
 
+    tick, check = watchdog.ticker()
+
     def muller_force(mbs, t, itemNumber, q, q_t):
-        watchdog(t, q_t[0])
+        if tick():
+            check(t, q_t[0])
         F = contact(angle(t, D), q[0], q_t[0], P)[0]
         return [F_rated * load(t, D) - F]
 
@@ -351,8 +354,11 @@ def _add_drive_and_meshes(built: BuiltSystem, layout: TorsionalLayout) -> None:
         P = m.parameters
         forces = compiled(single_mesh_drive_forces, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, P, D)
 
+        tick, check = watchdog.ticker()
+
         def drive_and_mesh(mbs, t, itemNumber, q, q_t):
-            watchdog(t, q_t[0])
+            if tick():
+                check(t, q_t[0])
             return forces(t, q_t[0], q[1], q[2], q_t[1], q_t[2], P, D)
 
         function = drive_and_mesh
@@ -364,8 +370,11 @@ def _add_drive_and_meshes(built: BuiltSystem, layout: TorsionalLayout) -> None:
         load = compiled(load_torque_at, 0.0, D)
         mesh_forces = compiled(torsional_mesh_forces, 0.0, 0.0, 0.0, 0.0, meshes[0][2])
 
+        tick, check = watchdog.ticker()
+
         def drive_and_meshes(mbs, t, itemNumber, q, q_t):
-            watchdog(t, q_t[im])
+            if tick():
+                check(t, q_t[im])
             f = [0.0] * n
             f[im] = motor(t, q_t[im], D)
             f[il] -= load(t, D)

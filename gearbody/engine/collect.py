@@ -9,7 +9,6 @@ import math
 
 import exudyn as exu
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline
 
 from ..analysis.antialias import band_limited_samples
 from ..assembly import gear_names, mesh_parameters_from_scenario, pack_drive_parameters
@@ -22,7 +21,7 @@ from ..physics.mesh import mesh_contact_series, mesh_phase_series
 from ..result import Result
 from ..version import __version__
 from .build import BuiltSystem
-from .sampling import OVERSAMPLING, is_band_limited, mesh_jump_times
+from .sampling import OVERSAMPLING, CubicHermite, is_band_limited, mesh_jump_times
 
 __all__ = ["collect"]
 
@@ -56,8 +55,8 @@ def collect(scenario: Scenario, built: BuiltSystem) -> Result:
     a[:, 0] = a[:, 1] if a.shape[1] > 1 else 0.0
     rate = scenario.solver.output_rate_hz
     n_out = math.floor(t_end * rate + 1e-9) + 1
-    position = CubicHermiteSpline(t_steps, q, v, axis=1)
-    velocity = CubicHermiteSpline(t_steps, v, a, axis=1)
+    position = CubicHermite(t_steps, q, v)
+    velocity = CubicHermite(t_steps, v, a)
 
     def states(times):
         return position(times), velocity(times), np.stack([np.interp(times, t_steps, row) for row in a])

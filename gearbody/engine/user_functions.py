@@ -5,6 +5,7 @@ millions of times per simulated second: keep these thin)."""
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 
@@ -81,7 +82,7 @@ class StallWatchdog:
     """Rides on the drive's force function, which every step attempt evaluates (no pre-step Python call
     per attempt): every CHECK_CALLS calls it checks the watched speed for divergence and draws the
     progress bar; every STALL_CALLS calls it checks that time advanced (Exudyn's step control can reject
-    steps at the minimum step size forever)."""
+    steps at the minimum step size forever). Hot force functions use :meth:`ticker`."""
 
     def __init__(self) -> None:
         self.calls, self.t_check, self.t_max = 0, -1.0, -1.0
@@ -105,6 +106,19 @@ class StallWatchdog:
             self.t_max = t
         if self.calls % CHECK_CALLS == 0:
             self._check(t, speed)
+
+    def ticker(self):
+        """``(tick, check)`` for a hot force function: ``if tick(): check(t, speed)`` costs one C call
+        per evaluation (~40 ns against ~200 ns for ``self(t, speed)``); ``tick()`` is true on every
+        CHECK_CALLS-th call, and ``check`` counts those calls and checks as ``self(t, speed)`` would."""
+        tick = itertools.cycle([False] * (CHECK_CALLS - 1) + [True]).__next__
+
+        def check(t: float, speed: float) -> None:
+            self.calls += CHECK_CALLS
+            self.t_max = max(self.t_max, t)
+            self._check(t, speed)
+
+        return tick, check
 
     def _check(self, t: float, speed: float) -> None:
         if not math.isfinite(speed) or abs(speed) > self.speed_limit:
@@ -151,8 +165,11 @@ def motor_user_function(D: np.ndarray, watchdog: StallWatchdog):
     """Motor torque (and the run's watchdog)."""
     torque = compiled(motor_torque_at, 0.0, 0.0, D)
 
+    tick, check = watchdog.ticker()
+
     def motor_torque(mbs, t, itemNumber, q, q_t):
-        watchdog(t, q_t[0])
+        if tick():
+            check(t, q_t[0])
         return (torque(t, q_t[0], D),)
 
     return motor_torque

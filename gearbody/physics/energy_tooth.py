@@ -72,7 +72,6 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .energy_damage import RootCrack
 from .energy_gears import SpurGear, SpurPair
@@ -135,6 +134,8 @@ def _crack_limit(gear: SpurGear, beta_0: float, h_q: float) -> float:
         return lo
     if f(beta_tip) >= 0.0:
         return math.inf
+    from scipy.optimize import brentq  # ~0.4 s to import: on use only
+
     return brentq(f, lo, beta_tip, xtol=1e-14)
 
 

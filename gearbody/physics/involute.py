@@ -10,8 +10,6 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from scipy.optimize import brentq
-
 _INVERSE_INVOLUTE_BRACKET_RAD = (1e-6, 1.5)
 
 
@@ -27,6 +25,8 @@ def inverse_involute(value: float) -> float:
         raise ValueError(f"inverse_involute: value = {value:g} must be > 0")
     if not involute(lo) <= value <= involute(hi):
         raise ValueError(f"inverse_involute: value = {value:g} outside [inv({lo:g}), inv({hi:g})]")
+    from scipy.optimize import brentq  # ~0.4 s to import: only for drives given by their drawing
+
     return brentq(lambda a: involute(a) - value, lo, hi, xtol=1e-15)
 
 
