@@ -207,6 +207,40 @@ class Result:
             },
         }
 
+    def period_boundaries_s(self) -> tuple[float, ...]:
+        """The run's operating periods: its start, every breakpoint of the speed and load profiles inside
+        the run, its end [s] (the four-period runs: 0, run-up end, load start, load rated, t_end)."""
+        t0, t1 = float(self.time_s[0]), float(self.time_s[-1])
+        operation = self.meta.get("scenario", {}).get("operation", {})
+        inner = {
+            float(t)
+            for profile in ("speed_profile", "load_profile")
+            for t in operation.get(profile, {}).get("time_s", ())
+            if t0 < float(t) < t1
+        }
+        return (t0, *sorted(inner), t1)
+
+    def record(self, natural_frequencies_hz=()):
+        """The run as an :class:`~gearbody.analysis.features.Record` for features (``natural_frequencies_hz``:
+        from ``gearbody.engine.natural_frequencies`` or measured, for the natural-frequency features)."""
+        from .analysis.features import Record
+
+        return Record(
+            time_s=self.time_s,
+            signals=self.signals,
+            pinion_teeth=int(self.meta["pinion_teeth"]),
+            wheel_teeth=int(self.meta["wheel_teeth"]),
+            period_boundaries_s=self.period_boundaries_s(),
+            natural_frequencies_hz=tuple(float(f) for f in natural_frequencies_hz),
+        )
+
+    def features(self, specs, natural_frequencies_hz=()) -> dict[str, float]:
+        """``{spec: value}`` of the named features (gearbody.analysis.features), e.g.
+        ``result.features(["kd_max:period=4", "line_amplitude:signal=pinion_accel_rad_s2,mesh=1"])``."""
+        from .analysis.features import evaluate_features
+
+        return evaluate_features(specs, self.record(natural_frequencies_hz))
+
     def plot(self, out_dir: str | Path) -> list[Path]:
         """The run's standard PNGs in ``out_dir``: K_d over time, K_d folded over the mesh period, the
         spectrum of the vibration signal, bearing forces (gearbody.plotting.run)."""

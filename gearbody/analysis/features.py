@@ -1,0 +1,344 @@
+"""Scalar features of a run or of a measurement: the numbers a diagnostician compares, and what
+sensitivity analysis ranks and calibration fits.
+
+A :class:`Record` is signals on one uniform time grid plus the drive facts features need (tooth
+counts, operating-period boundaries, natural frequencies when known). ``Result.record()`` gives one
+for a simulation; a measurement is built directly (a tachometer's pinion angle and an accelerometer
+signal suffice for the spectral features). A feature is named by a short spec, ``name`` or
+``name:key=value,key=value``:
+
+======================================  =======================================================
+``kd_max``, ``kd_mean``, ``kd_min``,     K_d statistic [-] of stage ``stage`` (default 1) over the
+``kd_std``, ``kd_p50/p95/p99``           analysed window
+``separation_fraction``                  fraction of the window with no contact force [-]
+``rms``                                  RMS of ``signal`` over the window [signal unit]
+``line_amplitude``                       amplitude [signal unit] of the spectral line at
+                                         ``mesh`` x f_z + ``order`` x f_``shaft`` in ``signal``
+                                         (mesh harmonics, sidebands, shaft orders)
+``fm0``, ``fm4``, ``m6a``, ``m8a``,      condition indicators [-] of the synchronous average of
+``na4``, ``energy_ratio``,               ``signal`` over revolutions of ``gear`` (pinion or wheel)
+``crest_factor``, ``kurtosis``,
+``tsa_rms``, ``tsa_peak_to_peak``
+``natural_frequency_hz``                 elastic natural frequency number ``mode`` (1-based) [Hz]
+======================================  =======================================================
+
+The analysed window is operating period ``period`` (1-based, from ``Record.period_boundaries_s``), or
+``from_s``/``to_s``, or by default the final ``fraction`` (0.25) of the record: the steady end of a
+run. The resonance speed of a speed sweep is :func:`resonance_speed`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .dynamic_factor import separation_stats
+from .indicators import condition_indicators_from_average
+from .spectrum import amplitude_spectrum, peak_near
+from .tsa import synchronous_average
+
+__all__ = [
+    "FEATURES",
+    "FeatureError",
+    "FeatureSpec",
+    "Record",
+    "evaluate_feature",
+    "evaluate_features",
+    "kd_statistic",
+    "line_amplitude",
+    "line_frequency_hz",
+    "natural_frequency_hz",
+    "parse_feature",
+    "resonance_speed",
+]
+
+DEFAULT_FRACTION = 0.25
+KD_STATISTICS = ("max", "mean", "min", "std", "p50", "p95", "p99")
+INDICATORS = {
+    "fm0": "fm0",
+    "fm4": "fm4",
+    "m6a": "m6a",
+    "m8a": "m8a",
+    "na4": "na4",
+    "energy_ratio": "energy_ratio",
+    "crest_factor": "crest_factor",
+    "kurtosis": "kurtosis",
+    "tsa_rms": "rms",
+    "tsa_peak_to_peak": "peak_to_peak",
+}
+WINDOW_OPTIONS = ("period", "from_s", "to_s", "fraction")
+FEATURES: dict[str, tuple[str, ...]] = {
+    **{f"kd_{s}": ("stage", *WINDOW_OPTIONS) for s in KD_STATISTICS},
+    "separation_fraction": ("stage", *WINDOW_OPTIONS),
+    "rms": ("signal", *WINDOW_OPTIONS),
+    "line_amplitude": ("signal", "mesh", "order", "shaft", "tolerance_bins", *WINDOW_OPTIONS),
+    **{name: ("signal", "gear", *WINDOW_OPTIONS) for name in INDICATORS},
+    "natural_frequency_hz": ("mode",),
+}
+"""Every feature name and the options it takes."""
+
+
+class FeatureError(ValueError):
+    """A feature spec that names no feature, takes an option it does not have, or cannot be computed
+    from the record (a missing signal, an empty window, an unknown natural frequency)."""
+
+
+# -- the feature functions on plain arrays ------------------------------------------------------------
+def kd_statistic(kd: ArrayLike, statistic: str = "max") -> float:
+    """``statistic`` of the K_d samples [-]: max, mean, min, std, p50, p95 or p99 (non-finite ignored)."""
+    values = np.asarray(kd, dtype=float).ravel()
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        raise FeatureError("kd: no finite samples in the window")
+    if statistic not in KD_STATISTICS:
+        raise FeatureError(f"kd statistic {statistic!r}: valid are {', '.join(KD_STATISTICS)}")
+    if statistic.startswith("p"):
+        return float(np.percentile(values, float(statistic[1:])))
+    return float(getattr(np, statistic)(values))
+
+
+def line_frequency_hz(
+    pinion_hz: float,
+    pinion_teeth: int,
+    wheel_teeth: int,
+    mesh: int = 1,
+    order: int = 0,
+    shaft: str = "pinion",
+) -> float:
+    """Frequency of the line ``mesh`` f_z + ``order`` f_shaft [Hz] of a gear pair whose pinion turns at
+    ``pinion_hz``: a mesh harmonic (order 0), a sideband (both non-zero) or a shaft order (mesh 0)."""
+    if shaft not in ("pinion", "wheel"):
+        raise FeatureError(f"shaft = {shaft!r}: valid are 'pinion', 'wheel'")
+    f_shaft = pinion_hz if shaft == "pinion" else pinion_hz * pinion_teeth / wheel_teeth
+    return mesh * pinion_hz * pinion_teeth + order * f_shaft
+
+
+def line_amplitude(
+    signal: ArrayLike, sample_rate_hz: float, frequency_hz: float, tolerance_bins: float = 2.0
+) -> float:
+    """Amplitude [signal unit] of the line at ``frequency_hz``: the largest bin of the Hann-windowed
+    amplitude spectrum (:func:`~gearbody.analysis.spectrum.amplitude_spectrum`) within
+    ``tolerance_bins`` bins of it (a sine of amplitude A on a bin reads A)."""
+    spec = amplitude_spectrum(signal, sample_rate_hz, window="hann")
+    if not 0.0 < frequency_hz < sample_rate_hz / 2:
+        raise FeatureError(
+            f"line at {frequency_hz:.6g} Hz: outside the spectrum (0, {sample_rate_hz / 2:.6g}) Hz"
+        )
+    return peak_near(spec, frequency_hz, tolerance_bins * spec.resolution_hz).amplitude
+
+
+def natural_frequency_hz(frequencies_hz: ArrayLike, mode: int = 1) -> float:
+    """The ``mode``-th (1-based) elastic natural frequency [Hz]: rigid-body modes (below 1e-5 of the
+    highest frequency) are skipped."""
+    f = np.sort(np.asarray(frequencies_hz, dtype=float).ravel())
+    if f.size == 0:
+        raise FeatureError("natural_frequency_hz: the record has no natural frequencies (compute the modes)")
+    elastic = f[f >= 1e-5 * f.max()]
+    if not 1 <= mode <= elastic.size:
+        raise FeatureError(f"natural_frequency_hz: mode = {mode}; the record has modes 1..{elastic.size}")
+    return float(elastic[mode - 1])
+
+
+def resonance_speed(speeds: ArrayLike, response: ArrayLike) -> tuple[float, bool]:
+    """The speed at which a speed sweep's ``response`` (e.g. max K_d per speed) peaks, refined by the
+    parabola through the largest sample and its two neighbours, in the unit of ``speeds``; and whether
+    the peak is inside the sweep (False: the largest response is at an end, the resonance may lie beyond)."""
+    s = np.asarray(speeds, dtype=float).ravel()
+    r = np.asarray(response, dtype=float).ravel()
+    if s.size != r.size or s.size < 3:
+        raise FeatureError(f"resonance_speed: need >= 3 speeds and as many responses, got {s.size}, {r.size}")
+    order = np.argsort(s)
+    s, r = s[order], r[order]
+    if np.any(np.diff(s) <= 0) or not np.all(np.isfinite(r)):
+        raise FeatureError("resonance_speed: speeds must be distinct and responses finite")
+    k = int(np.argmax(r))
+    if k in (0, s.size - 1):
+        return float(s[k]), False
+    a, b, _ = np.polyfit(s[k - 1 : k + 2], r[k - 1 : k + 2], 2)
+    vertex = -b / (2.0 * a) if a < 0 else s[k]
+    return float(min(max(vertex, s[k - 1]), s[k + 1])), True
+
+
+# -- records and specs ----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Record:
+    """Signals on one uniform time grid and the facts of the drive that features need.
+
+    ``signals`` by name as a Result names them: ``kd``, ``mesh_force_N`` (stage k > 1: ``stage_k_kd``, ...),
+    ``pinion_angle_rad`` (a tachometer's angle suffices for spectra and synchronous averages), any
+    vibration signal. ``period_boundaries_s``: start of the first operating period, every boundary, end.
+    """
+
+    time_s: NDArray[np.float64]
+    signals: Mapping[str, NDArray[np.float64]]
+    pinion_teeth: int
+    wheel_teeth: int
+    period_boundaries_s: tuple[float, ...] = ()
+    natural_frequencies_hz: tuple[float, ...] = ()
+
+    def __post_init__(self) -> None:
+        t = np.asarray(self.time_s, dtype=float)
+        if t.ndim != 1 or t.size < 2 or not np.all(np.diff(t) > 0):
+            raise FeatureError("Record.time_s: need >= 2 strictly increasing sample times")
+        for name, values in self.signals.items():
+            if np.shape(values) != t.shape:
+                raise FeatureError(
+                    f"Record signal {name!r}: {np.shape(values)} samples, time_s has {t.shape}"
+                )
+        for name in ("pinion_teeth", "wheel_teeth"):
+            if int(getattr(self, name)) < 1:
+                raise FeatureError(f"Record.{name} = {getattr(self, name)}: must be >= 1")
+
+    @property
+    def sample_rate_hz(self) -> float:
+        return float((self.time_s.size - 1) / (self.time_s[-1] - self.time_s[0]))
+
+    def signal(self, name: str) -> NDArray[np.float64]:
+        if name not in self.signals:
+            raise FeatureError(f"signal {name!r} not in the record (has: {', '.join(sorted(self.signals))})")
+        return np.asarray(self.signals[name], dtype=float)
+
+    def window(self, options: Mapping[str, float]) -> NDArray[np.bool_]:
+        """Mask of the analysed samples: operating ``period``, or ``from_s``..``to_s``, or the final
+        ``fraction`` (default 0.25)."""
+        t = self.time_s
+        if "period" in options:
+            edges = self.period_boundaries_s
+            n = int(options["period"])
+            if not 1 <= n <= len(edges) - 1:
+                raise FeatureError(f"period = {n}: the record has periods 1..{max(len(edges) - 1, 0)}")
+            last = n == len(edges) - 1
+            mask = (t >= edges[n - 1]) & ((t <= edges[n]) if last else (t < edges[n]))
+        elif "from_s" in options or "to_s" in options:
+            mask = (t >= options.get("from_s", -math.inf)) & (t <= options.get("to_s", math.inf))
+        else:
+            fraction = float(options.get("fraction", DEFAULT_FRACTION))
+            if not 0 < fraction <= 1:
+                raise FeatureError(f"fraction = {fraction}: must be > 0 and <= 1")
+            mask = t >= t[-1] - fraction * (t[-1] - t[0])
+        if np.count_nonzero(mask) < 2:
+            raise FeatureError(f"window {dict(options)}: fewer than 2 samples")
+        return mask
+
+    def pinion_hz(self, mask: NDArray[np.bool_], stage: int = 1) -> float:
+        """Mean pinion rotation frequency [Hz] over the window, from the pinion angle."""
+        angle = self.signal(_stage_name("pinion_angle_rad", stage))[mask]
+        t = self.time_s[mask]
+        return float((angle[-1] - angle[0]) / (t[-1] - t[0]) / (2.0 * math.pi))
+
+
+@dataclass(frozen=True)
+class FeatureSpec:
+    """A feature name and its options, e.g. ``line_amplitude:signal=pinion_accel_rad_s2,mesh=1,order=-1``."""
+
+    name: str
+    options: Mapping[str, float | str] = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        if not self.options:
+            return self.name
+        return self.name + ":" + ",".join(f"{k}={_fmt(v)}" for k, v in self.options.items())
+
+
+def _fmt(value: float | str) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def parse_feature(text: str) -> FeatureSpec:
+    """A :class:`FeatureSpec` from ``name`` or ``name:key=value,...`` (numbers become floats, or ints
+    for the integer options); unknown names and options are refused with the valid ones."""
+    name, _, rest = text.strip().partition(":")
+    name = name.strip()
+    if name not in FEATURES:
+        raise FeatureError(f"feature {text!r}: no feature {name!r}; valid are {', '.join(FEATURES)}")
+    options: dict[str, float | str] = {}
+    for item in filter(None, (p.strip() for p in rest.split(","))):
+        key, eq, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not eq or key not in FEATURES[name]:
+            raise FeatureError(
+                f"feature {text!r}: option {item!r} not understood; {name} takes "
+                f"{', '.join(f'{o}=...' for o in FEATURES[name])}"
+            )
+        options[key] = _option_value(text, key, value)
+    return FeatureSpec(name, options)
+
+
+_INT_OPTIONS = ("period", "stage", "mesh", "order", "mode")
+_STR_OPTIONS = ("signal", "shaft", "gear")
+
+
+def _option_value(text: str, key: str, value: str) -> float | str:
+    if key in _STR_OPTIONS:
+        return value
+    try:
+        number = float(value)
+    except ValueError:
+        raise FeatureError(f"feature {text!r}: {key} = {value!r} is not a number") from None
+    if not math.isfinite(number):
+        raise FeatureError(f"feature {text!r}: {key} = {value!r} must be finite")
+    if key in _INT_OPTIONS:
+        if number != int(number):
+            raise FeatureError(f"feature {text!r}: {key} = {value!r} must be an integer")
+        return int(number)
+    return number
+
+
+def _stage_name(name: str, stage: int) -> str:
+    if stage < 1:
+        raise FeatureError(f"stage = {stage}: stages count from 1")
+    return name if stage == 1 else f"stage_{stage}_{name}"
+
+
+def evaluate_feature(spec: FeatureSpec | str, record: Record) -> float:
+    """The value of one feature of ``record`` (see the module's table for names, options and units)."""
+    spec = parse_feature(spec) if isinstance(spec, str) else spec
+    name, o = spec.name, dict(spec.options)
+    if name == "natural_frequency_hz":
+        return natural_frequency_hz(record.natural_frequencies_hz, int(o.get("mode", 1)))
+    if "signal" in FEATURES[name] and "signal" not in o:
+        raise FeatureError(f"feature {spec}: give the signal, e.g. {name}:signal=pinion_accel_rad_s2")
+    mask = record.window(o)
+    stage = int(o.get("stage", 1))
+    if name.startswith("kd_"):
+        return kd_statistic(record.signal(_stage_name("kd", stage))[mask], name[3:])
+    if name == "separation_fraction":
+        force = record.signal(_stage_name("mesh_force_N", stage))[mask]
+        return float(separation_stats(force, record.time_s[mask]).separated_fraction)
+    x = record.signal(str(o["signal"]))[mask]
+    if name == "rms":
+        return float(np.sqrt(np.mean(x**2)))
+    if name == "line_amplitude":
+        f = line_frequency_hz(
+            record.pinion_hz(mask),
+            record.pinion_teeth,
+            record.wheel_teeth,
+            int(o.get("mesh", 1)),
+            int(o.get("order", 0)),
+            str(o.get("shaft", "pinion")),
+        )
+        return line_amplitude(x, record.sample_rate_hz, f, float(o.get("tolerance_bins", 2.0)))
+    gear = str(o.get("gear", "pinion"))
+    if gear not in ("pinion", "wheel"):
+        raise FeatureError(f"feature {spec}: gear = {gear!r}; valid are 'pinion', 'wheel'")
+    angle, teeth = record.signal("pinion_angle_rad")[mask], record.pinion_teeth
+    if gear == "wheel":  # its own angle if recorded, else the pinion's through the tooth ratio
+        teeth = record.wheel_teeth
+        ratio = record.pinion_teeth / record.wheel_teeth
+        angle = (
+            record.signal("wheel_angle_rad")[mask] if "wheel_angle_rad" in record.signals else angle * ratio
+        )
+    if abs(angle[-1] - angle[0]) < 4 * math.pi:
+        raise FeatureError(f"feature {spec}: the window holds less than 2 revolutions of the {gear}")
+    average = synchronous_average(x, angle, teeth=teeth)
+    return float(condition_indicators_from_average(average).as_dict()[INDICATORS[name]])
+
+
+def evaluate_features(specs: Sequence[FeatureSpec | str], record: Record) -> dict[str, float]:
+    """``{str(spec): value}`` for every spec, in order."""
+    parsed = [parse_feature(s) if isinstance(s, str) else s for s in specs]
+    return {str(s): evaluate_feature(s, record) for s in parsed}
