@@ -68,6 +68,15 @@ def test_spectral_lines_read_their_amplitudes_by_kind(record):
     assert rms == pytest.approx(math.sqrt((3.0**2 + 0.5**2 + 0.2**2) / 2), rel=1e-9)
 
 
+def test_a_sideband_the_window_cannot_resolve_is_refused(record):
+    """20 Hz between pinion orders; the final 0.25 s window resolves 4 Hz x 2 bins: fine; 0.05 s is not."""
+    assert evaluate_feature("line_amplitude:signal=pinion_accel_rad_s2,mesh=1,order=-1", record) > 0.4
+    with pytest.raises(
+        FeatureError, match=r"window resolves lines to 40 Hz, not the 20 Hz .* longer than 0.2 s"
+    ):
+        evaluate_feature("line_amplitude:signal=pinion_accel_rad_s2,mesh=1,order=-1,fraction=0.05", record)
+
+
 def test_kd_statistics_and_windows(record):
     kd = record.signals["kd"]
     assert evaluate_feature("kd_max:period=1", record) == kd[record.time_s < 0.5].max()

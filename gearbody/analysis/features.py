@@ -321,7 +321,23 @@ def evaluate_feature(spec: FeatureSpec | str, record: Record) -> float:
             int(o.get("order", 0)),
             str(o.get("shaft", "pinion")),
         )
-        return line_amplitude(x, record.sample_rate_hz, f, float(o.get("tolerance_bins", 2.0)))
+        bins = float(o.get("tolerance_bins", 2.0))
+        if int(o.get("order", 0)) != 0:  # a sideband or shaft order: its neighbours lie f_shaft away
+            shaft = str(o.get("shaft", "pinion"))
+            f_shaft = abs(
+                line_frequency_hz(
+                    record.pinion_hz(mask), record.pinion_teeth, record.wheel_teeth, 0, 1, shaft
+                )
+            )
+            tolerance_hz = bins * record.sample_rate_hz / np.count_nonzero(mask)
+            if tolerance_hz >= f_shaft / 2:
+                duration = record.time_s[mask][-1] - record.time_s[mask][0]
+                raise FeatureError(
+                    f"feature {spec}: a {duration:.3g} s window resolves lines to {tolerance_hz:.3g} Hz, not "
+                    f"the {f_shaft:.3g} Hz between this line and the next ({shaft} orders): use a window "
+                    f"longer than {2 * bins / f_shaft:.3g} s or fewer tolerance_bins"
+                )
+        return line_amplitude(x, record.sample_rate_hz, f, bins)
     gear = str(o.get("gear", "pinion"))
     if gear not in ("pinion", "wheel"):
         raise FeatureError(f"feature {spec}: gear = {gear!r}; valid are 'pinion', 'wheel'")
