@@ -297,6 +297,14 @@ ONE_STAGE = [*(f"--set={o}" for o in STEADY_OVERRIDES), "--t-end", "0.03", "--wo
         (["--key", "design.mesh.damping_Ns_per_m=1:2", "--feature", "kd_maximum"], "--feature kd_maximum"),
         (["--key", "design.mesh.damping_Ns_per_m=1:2", "--feature", "kd_max:signal=x"], "option 'signal=x'"),
         (["--key", "design.mesh.damping_Ns_per_m=1:2"], "give one or more --feature"),
+        (
+            ["--key", "design.mesh.damping_Ns_per_m=1:2", "--feature", "rms:signal=wheel_accel_m_s2"],
+            "records no signal 'wheel_accel_m_s2'; it records ",
+        ),
+        (
+            ["--key", "design.mesh.damping_Ns_per_m=1:2", "--feature", "kd_max:stage=2"],
+            "records no signal 'stage_2_kd'",
+        ),
         (["--key", "design.mesh.damping_Ns_per_m=2:1", "--feature", "kd_max"], "low < high"),
         (
             ["--key", "design.mesh.damping_Ns_per_m=1:2", "--feature", "kd_max", "--samples", "1001"],

@@ -592,8 +592,9 @@ def sensitivity(
     """Sensitivity of a scene's ``features`` (specs of :mod:`gearbody.analysis.features`, e.g.
     ``kd_max``, ``line_amplitude:signal=pinion_accel_rad_s2,mesh=1``) to scenario ``keys`` over their
     ranges, e.g. ``{"design.mesh.damping_Ns_per_m": (3000, 12000)}``; ``overrides``: fixed
-    ``KEY=VALUE`` of every run (``--set``). Every key, range end and row is checked (its scenario
-    loaded) and every feature parsed before anything runs. More than ``max_runs`` simulations are
+    ``KEY=VALUE`` of every run (``--set``). Before anything runs: every key, range end and sample row
+    is checked (its scenario loaded), every feature parsed, and the signals the features read looked
+    up in a probe run of :data:`PROBE_S`. More than ``max_runs`` simulations are
     refused unless ``force``. Other options as for :func:`analyse_model` (levels, second_order,
     retry_failed, exclude_failed, progress, ...)."""
     from gearbody.analysis.features import FeatureError, parse_feature
@@ -620,6 +621,12 @@ def sensitivity(
                 load_scenario(dict(base), [*overrides, f"{k}={v!r}"])
             except ScenarioError as exc:
                 raise SweepSpecError(f"--key {k}={lo!r}:{hi!r}: at {k} = {v!r}: {exc}") from None
+    parsed = [parse_feature(f) for f in specs]
+
+    def check(X: np.ndarray) -> None:  # after the options are checked, before anything is written
+        _check_rows(problem, base, overrides, X)
+        _check_signals(base, overrides, parsed)
+
     return analyse_model(
         scene_features,
         problem,
@@ -635,9 +642,43 @@ def sensitivity(
         max_runs=max_runs,
         force=force,
         title=f"{Path(label).name if len(label) > 40 else label}: {method} sensitivity indices",
-        check=lambda X: _check_rows(problem, base, overrides, X),
+        check=check,
         **options,
     )
+
+
+PROBE_S = 0.002
+"""Simulated time of the probe run that finds the signals a scene records (a few hundredths of a second)."""
+
+
+def _check_signals(base: Mapping[str, Any], overrides: Sequence[str], specs) -> None:
+    """Every signal the features read is one the scene records: a probe run of PROBE_S finds them."""
+    need = {}
+    for spec in specs:
+        stage = int(spec.options.get("stage", 1))
+        prefix = "" if stage == 1 else f"stage_{stage}_"
+        if spec.name.startswith("kd_"):
+            need[f"{prefix}kd"] = spec
+        elif spec.name == "separation_fraction":
+            need[f"{prefix}mesh_force_N"] = spec
+        elif "signal" in spec.options:
+            need[str(spec.options["signal"])] = spec
+    if not need:
+        return
+    from gearbody.engine import simulate
+    from gearbody.errors import SimulationError
+    from gearbody.model import load_scenario
+
+    try:
+        names = simulate(load_scenario(dict(base), [*overrides, f"operation.t_end_s={PROBE_S}"])).signals
+    except SimulationError:
+        return  # the runs will say why
+    for name, spec in need.items():
+        if name not in names:
+            raise SweepSpecError(
+                f"--feature {spec}: the scene records no signal {name!r}; it records "
+                f"{', '.join(sorted(names))}"
+            )
 
 
 def _check_rows(problem, base, overrides, X: np.ndarray) -> None:
