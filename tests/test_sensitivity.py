@@ -247,6 +247,7 @@ def test_a_job_whose_worker_died_records_its_rows_failed(tmp_path, monkeypatch):
         ({"keys": ["x1=a:2"]}, "two numbers"),
         ({"keys": ["x1=0:1:5"]}, "two numbers"),
         ({"keys": {"x1": (0, 1, 2)}}, r"as \(low, high\)"),
+        ({"keys": {"x1": "0:1"}}, r"as \(low, high\)"),
         ({"keys": []}, "at least one --key"),
         ({"method": "fast"}, "valid are morris, sobol"),
         ({"method": "sobol", "samples": 100}, "power of 2"),
@@ -264,8 +265,9 @@ def test_bad_input_is_refused_before_anything_runs(tmp_path, kw, message):
 
 
 def test_force_lifts_the_run_limit(tmp_path):
+    keys = {k: np.array(b) for k, b in ISHIGAMI.items()}  # ranges as arrays are fine too
     res = analyse_model(
-        ishigami, ISHIGAMI, ["y"], out=tmp_path, samples=8, max_runs=10, force=True, workers=1, progress=False
+        ishigami, keys, ["y"], out=tmp_path, samples=8, max_runs=10, force=True, workers=1, progress=False
     )
     assert res.rows == 32
 
@@ -374,6 +376,18 @@ def test_a_key_that_cannot_affect_the_features_gets_zero_on_gearbody(tmp_path, c
     assert (
         "12 of 12 rows already recorded" in captured.err and "(0 runs now, 12 recorded before" in captured.out
     )
+
+
+def test_cli_runs_that_fail_exit_1_recorded_with_their_cause(tmp_path, capsys):
+    """A steady run has one operating period: kd_max:period=2 fails in every run (4 runs)."""
+    out = tmp_path / "failing"
+    argv = ["sensitivity", "one-stage", "--key", f"{STIFFNESS}=1.0e9:1.25e9", "--feature", "kd_max:period=2"]
+    assert main([*argv, "--samples", "2", *ONE_STAGE, "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "4 of 4 rows failed or missing (rows 0, 1, 2, 3; row 0: FeatureError: period = 2" in err
+    assert "--exclude-failed" in err and not (out / "indices.csv").exists()
+    entries = [json.loads(p.read_text())["rows"][0] for p in sorted((out / "evaluations").glob("*.json"))]
+    assert [e["error_type"] for e in entries] == ["FeatureError"] * 4
 
 
 def test_mesh_damping_cannot_move_an_undamped_natural_frequency(tmp_path):

@@ -125,7 +125,7 @@ def _problem(keys: Mapping[str, tuple[float, float]] | Sequence[str]) -> dict[st
         items = []
         for k, bounds in keys.items():
             check_key(k, f"key {k}")
-            if not isinstance(bounds, Sequence) or isinstance(bounds, str) or len(bounds) != 2:
+            if isinstance(bounds, str) or np.shape(bounds) != (2,):
                 raise SweepSpecError(f"key {k}: give the range as (low, high), got {bounds!r}")
             items.append((k, *_check_bounds(k, bounds[0], bounds[1], f"key {k}")))
     else:
