@@ -272,6 +272,12 @@ def test_force_lifts_the_run_limit(tmp_path):
     assert res.rows == 32
 
 
+def test_cli_help_states_the_run_limit(capsys):
+    with pytest.raises(SystemExit):
+        main(["sensitivity", "--help"])
+    assert f"At most {sens.MAX_RUNS} runs" in " ".join(capsys.readouterr().out.split())
+
+
 def test_parse_key_range():
     assert parse_key_range("design.mesh.damping_Ns_per_m=3e3:1.2e4") == (
         "design.mesh.damping_Ns_per_m",

@@ -11,8 +11,6 @@ from .common import EXIT_OK, add_out, add_set, scenario_overrides, usage_error
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
-    from gearbody.studies.sensitivity import MAX_RUNS
-
     se = sub.add_parser(
         "sensitivity",
         help="Morris screening or Sobol indices of features to scenario keys over ranges, resumable",
@@ -22,8 +20,8 @@ def register(sub) -> argparse.ArgumentParser:
             "elementary-effect statistics (mu*, sigma) or Sobol indices (S1, ST, S2) with bootstrap "
             "confidence half-widths. Writes DIR/sensitivity.json, DIR/evaluations/<job>.json (one per "
             "run), DIR/indices.csv, indices.md, indices.json and indices.png. Rerunning the same command "
-            f"on DIR resumes it. At most {MAX_RUNS} runs unless --force. Runs: Morris samples x (keys + 1), "
-            "Sobol samples x (2 keys + 2). Exit code 0: indices written; 1: runs failed (recorded; no "
+            "on DIR resumes it. At most 2000 runs unless --force. Runs: Morris samples x (keys + 1), Sobol "
+            "samples x (2 keys + 2). Exit code 0: indices written; 1: runs failed (recorded; no "
             "indices); 2: bad input. See docs/features.md."
         ),
         epilog="examples:\n"
@@ -68,7 +66,7 @@ def register(sub) -> argparse.ArgumentParser:
         metavar="ADDRESS",
         help="run on a Dask cluster, e.g. tcp://host:8786 (needs: pip install gearbody[sweep])",
     )
-    se.add_argument("--force", action="store_true", help=f"allow more than {MAX_RUNS} runs")
+    se.add_argument("--force", action="store_true", help="allow more runs than the limit (2000)")
     se.add_argument("--retry-failed", action="store_true", help="on resume, rerun the runs that failed")
     se.add_argument(
         "--exclude-failed",
