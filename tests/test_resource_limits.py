@@ -218,3 +218,18 @@ def test_render_frames_are_bounded_before_anything_is_simulated(tmp_path, capsys
     check_frames(1000, 800, 600, "none")
     with pytest.raises(RenderError, match=r"frames = 0"):
         check_frames(0, 800, 600)
+
+
+def test_a_soft_mesh_that_runs_out_of_range_is_blamed_on_its_stiffness(steady_scenario):
+    """Found by tests/test_fuzz_simulate.py: the hint spoke of a tooth stiffness factor of 0."""
+    sc = steady_scenario(
+        "one-stage",
+        "design.mesh.stiffness_single_N_per_m=1e5",
+        "design.mesh.stiffness_double_N_per_m=1e5",
+        t_end=0.002,
+    )
+    with pytest.raises(SimulationError) as info:
+        simulate(sc)
+    msg = str(info.value)
+    assert "mean mesh stiffness 1e+05 N/m deflects 103 mm" in msg
+    assert "raise design.stages.1.mesh.stiffness_single_N_per_m" in msg and "factor of 0" not in msg

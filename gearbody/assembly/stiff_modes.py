@@ -61,7 +61,8 @@ def coordinate_frequencies(scenario: Scenario) -> list[CoordinateFrequency]:
             CoordinateFrequency(
                 "deflection",
                 math.sqrt(k / m) / (2 * math.pi),
-                "design.pinion.inertia_kg_m2 / design.wheel.inertia_kg_m2 (reduced mass)",
+                "the reduced mass m = 1 / (r1^2 / I_pinion + r2^2 / I_wheel) of "
+                "design.pinion.inertia_kg_m2 and design.wheel.inertia_kg_m2",
                 m,
                 k,
             )
@@ -109,8 +110,8 @@ def check_resolved_modes(scenario: Scenario) -> None:
         return
     rest = [c.frequency_hz for c in freqs if c.key != worst.key]
     rest_text = f"; the model's other coordinates reach {max(rest):.3g} Hz" if rest else ""
-    lateral = worst.name.endswith(("_x", "_y"))
-    unit, k_unit = ("kg", "N/m") if lateral else ("kg m^2", "N m/rad")
+    translation = worst.name.endswith(("_x", "_y")) or worst.name == "deflection"
+    unit, k_unit = ("kg", "N/m") if translation else ("kg m^2", "N m/rad")
     steps = scenario.operation.t_end_s * math.pi * worst.frequency_hz
     raise ScenarioError(
         f"{worst.key} = {worst.mass:g} {unit}: against its stiffness ({worst.stiffness:.3g} {k_unit}, from "
