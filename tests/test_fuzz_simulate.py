@@ -26,7 +26,7 @@ from hypothesis import strategies as st  # noqa: E402
 
 pytestmark = pytest.mark.slow
 
-EXAMPLES = 150
+EXAMPLES = 300
 CASE_TIMEOUT_S = 60.0
 WORKER_MEMORY_BYTES = 3 * 2**30
 T_END_S = 0.01
@@ -169,15 +169,22 @@ def worker(request):
         w = Worker(Path(tmp) / "worker-stderr.txt")
         w.outcomes = collections.Counter()
         w.errors = []
+        w.walls = []
         yield w
         w.stop()
         printed = w.stderr_path.read_text() if w.stderr_path.exists() else ""
         reporter = request.config.pluginmanager.get_plugin("terminalreporter")
-        if reporter is not None:
-            reporter.write_line(f"fuzz (simulate {T_END_S} s): {dict(w.outcomes)}")
-            if request.config.get_verbosity() > 0:  # -v: every error message, for reading
-                for line in sorted(w.errors):
-                    reporter.write_line(f"  {line[:400]}")
+        capture = request.config.pluginmanager.get_plugin("capturemanager")
+        if reporter is not None and capture is not None:
+            walls = sorted(w.walls) or [0.0]
+            with capture.global_and_fixture_disabled():
+                reporter.write_line(
+                    f"\nfuzz (simulate {T_END_S} s): {dict(w.outcomes)}; wall per case: median "
+                    f"{walls[len(walls) // 2]:.2f} s, max {walls[-1]:.2f} s"
+                )
+                if request.config.get_verbosity() > 0:  # -v: every error message, for reading
+                    for line in sorted(w.errors):
+                        reporter.write_line(f"  {line[:400]}")
         for text in FOREIGN_TEXT[:3]:
             assert text not in printed, f"a run printed {text!r}"
 
@@ -194,9 +201,10 @@ def test_extreme_valid_scenarios_end_in_a_result_or_a_documented_error(worker, c
     scene, overrides = case
     answer = worker.run(scene, overrides)
     worker.outcomes[answer["outcome"]] += 1
+    worker.walls.append(answer.get("wall_s", CASE_TIMEOUT_S))
     where = f"{scene} {overrides}"
     if answer["outcome"] != "result":
-        worker.errors.append(f"{answer['outcome']}: {answer.get('message', '')}")
+        worker.errors.append(f"{answer['outcome']}: {answer.get('message', '')[:150]} <- {where}")
     assert answer["outcome"] in ("result", "InputError", "SimulationError"), f"{where}: {answer}"
     if answer["outcome"] == "result":
         assert answer["samples"] == round(T_END_S * 20000) + 1, where

@@ -19,18 +19,16 @@ from ..assembly import (
     check_resolved_modes,
     initial_state,
     mesh_frequency_hz,
-    mesh_parameters_from_scenario,
     static_lateral_displacements_m,
     torsional_layout,
 )
 from ..errors import GearbodyError, SimulationError
 from ..model import Scenario
 from ..model.budget import memory_limit_bytes
-from ..model.params import stage_key
-from ..physics import mean_stiffness_N_per_m
 from ..result import Result
 from .build import BuiltSystem, build_muller, build_torsional
 from .collect import collect
+from .hints import divergence_hint, mesh_range_hint, stall_hint
 
 SOLVER_TYPES = {
     name: getattr(exu.DynamicSolverType, name) for name in ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")
@@ -96,6 +94,8 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
         memory_limit_bytes=memory_limit_bytes(scenario),
         memory_limit_default=sv.memory_limit_MiB is None,
         max_step_s=sv.max_step_s,
+        stall_hint=stall_hint(scenario),
+        divergence_hint=divergence_hint(scenario),
     )
     settings = solver_settings(scenario)
     t_solve0 = time.perf_counter()
@@ -158,19 +158,7 @@ def _check_mesh_range(scenario: Scenario, result: Result) -> None:
         p_b = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
         if delta.max() > MAX_DEFLECTION_BASE_PITCH * p_b:
             m = int(np.argmax(delta > MAX_DEFLECTION_BASE_PITCH * p_b))
-            load = max(scenario.operation.load_profile.fraction) * scenario.stage_rated_force_N(k)
-            k_mean = mean_stiffness_N_per_m(mesh_parameters_from_scenario(scenario, k))
-            if load / k_mean > 0.5 * MAX_DEFLECTION_BASE_PITCH * p_b:  # soft mesh: deflects statically
-                hint = (
-                    f"the mean mesh stiffness {k_mean:.3g} N/m deflects {load / k_mean * 1e3:.3g} mm under "
-                    f"the highest load ({load:.4g} N): raise {stage_key(k, 'mesh')}.stiffness_single_N_per_m "
-                    "/ stiffness_double_N_per_m or lower the load"
-                )
-            else:
-                hint = (
-                    "a tooth stiffness factor of 0 leaves no load path for a whole mesh period in the "
-                    "lumped model; use a factor > 0 (e.g. 0.2), or check loads and stiffnesses"
-                )
+            hint = mesh_range_hint(scenario, k, MAX_DEFLECTION_BASE_PITCH * p_b)
             raise SimulationError(
                 f"stage {k + 1}: the mesh deflection reached {delta[m] * 1e3:.3g} mm at t = "
                 f"{result.time_s[m]:.6g} s, more than {MAX_DEFLECTION_BASE_PITCH:g} of the base pitch "

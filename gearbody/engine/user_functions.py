@@ -115,6 +115,10 @@ class StallWatchdog:
         self.memory_limit_default = False
         self.memory0_bytes = 0
         self.max_step_s = math.inf
+        self.stall_hint = ""
+        self.divergence_hint = (
+            "check stiffness, inertia and load values, or tighten solver tolerances / lower solver.max_step_s"
+        )
 
     def watch(
         self,
@@ -128,15 +132,19 @@ class StallWatchdog:
         memory_limit_bytes: float | None = None,
         memory_limit_default: bool = False,
         max_step_s: float = math.inf,
+        stall_hint: str = "",
+        divergence_hint: str = "",
     ) -> None:
         """Set what the run watches: divergence above ``speed_limit`` of the watched speed, a progress
-        bar, the wall-time and memory budgets (None: unlimited), the largest step (for stall hints)."""
+        bar, the wall-time and memory budgets (None: unlimited), the largest step and the scenario's
+        likely causes of a stall or a divergence (hints for the messages)."""
         self.t_end, self.speed_limit, self.progress = t_end, speed_limit, progress
         self.speed_name, self.speed_unit = name, unit
         self.wall_time_limit_s = math.inf if wall_time_limit_s is None else wall_time_limit_s
         self.memory_limit_bytes = math.inf if memory_limit_bytes is None else memory_limit_bytes
         self.memory_limit_default = memory_limit_default
-        self.max_step_s = max_step_s
+        self.max_step_s, self.stall_hint = max_step_s, stall_hint
+        self.divergence_hint = divergence_hint or self.divergence_hint
         if memory_limit_bytes is not None:
             self.memory0_bytes = resident_memory_bytes()
         self.t_wall0 = time.monotonic()
@@ -164,9 +172,8 @@ class StallWatchdog:
     def _check(self, t: float, speed: float) -> None:
         if not math.isfinite(speed) or abs(speed) > self.speed_limit:
             self.failure = (
-                f"state diverged at t = {t:.6g} s ({self.speed_name} {speed:.3g} {self.speed_unit}). Hint: "
-                "check stiffness, inertia and load values, or tighten solver tolerances / lower "
-                "solver.max_step_s"
+                f"state diverged at t = {t:.6g} s ({self.speed_name} {speed:.3g} {self.speed_unit}). "
+                f"Hint: {self.divergence_hint}"
             )
             raise StallError(self.failure)
         now = time.monotonic()
@@ -218,6 +225,8 @@ class StallWatchdog:
                 f"{what}: solver.max_step_s = {self.max_step_s:g} s caps every step. Hint: raise "
                 "solver.max_step_s (default 1e-4 s)"
             )
+        elif self.stall_hint:
+            self.failure = f"{what} (step size collapse at a jump of the mesh law). Hint: {self.stall_hint}"
         else:
             self.failure = (
                 f"{what} (step size collapse at a discontinuity, e.g. a tooth with stiffness factor 0 "
