@@ -11,6 +11,7 @@ from .operating_point import (
     steady_operating_point,
 )
 from .parameters import mesh_parameters_from_scenario, pack_drive_parameters
+from .stiff_modes import check_resolved_modes, coordinate_frequencies
 from .topology import (
     Inertia,
     LateralSupport,
@@ -28,6 +29,8 @@ __all__ = [
     "MeshLink",
     "ShaftLink",
     "TorsionalLayout",
+    "check_resolved_modes",
+    "coordinate_frequencies",
     "gear_names",
     "initial_state",
     "mesh_frequency_hz",

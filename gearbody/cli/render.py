@@ -91,7 +91,7 @@ def register(sub) -> argparse.ArgumentParser:
 
 
 def execute(args) -> int:
-    from gearbody.render import RenderError, RenderOptions, render, view
+    from gearbody.render import RenderError, RenderOptions, check_frames, render, view
     from gearbody.result import Result
 
     overrides = scenario_overrides(args)
@@ -115,6 +115,8 @@ def execute(args) -> int:
     )
     try:
         options.check()
+        if args.frames is not None:  # before anything is simulated
+            check_frames(args.frames, args.width, args.height, "none" if args.interactive else args.format)
         if args.t_end is not None and (args.result is not None or args.kinematic):
             raise RenderError(
                 "--t-end applies only when SCENE is simulated first (not with --result or --kinematic)"

@@ -13,7 +13,8 @@ import numpy as np
 from ..analysis.antialias import band_limited_samples
 from ..assembly import gear_names, mesh_parameters_from_scenario, pack_drive_parameters
 from ..errors import SimulationError
-from ..model import Scenario, scenario_to_dict
+from ..model import Scenario, budget, scenario_to_dict
+from ..model.params import stage_key
 from ..physics import load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
 from ..physics.lateral import mesh_directions
@@ -119,15 +120,27 @@ def _point_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> dict[s
 def _oversampling(scenario: Scenario, built: BuiltSystem, v_steps: np.ndarray) -> int:
     """Fine points per output sample: OVERSAMPLING, or more so that every smoothed transition of the
     mesh law (``transition_width`` w of a mesh period) spans at least 3 fine points at the fastest
-    mesh frequency of the run."""
-    M = OVERSAMPLING
+    mesh frequency of the run. The run's fine grid must fit its memory budget (estimated before the
+    run from the expected speeds; checked here with the measured ones)."""
+    M, stage = OVERSAMPLING, None
     for k, st in enumerate(scenario.stages):
         w = st.mesh.transition_width
         if w > 0:
             name = gear_names(k)[0]
             row = built.dof_names.index(name)
             f_mesh_hz = st.pinion.teeth * float(np.max(np.abs(v_steps[row]))) / (2 * math.pi)
-            M = max(M, math.ceil(3.0 * f_mesh_hz / (w * scenario.solver.output_rate_hz)))
+            m = budget.oversampling(f_mesh_hz, w, scenario.solver.output_rate_hz)
+            if m > M:
+                M, stage = m, k
+    need, limit = budget.output_memory_bytes(scenario, M), budget.memory_limit_bytes(scenario)
+    if stage is not None and need > limit:
+        w = scenario.stages[stage].mesh.transition_width
+        raise SimulationError(
+            f"stage {stage + 1}: the pinion ran faster than expected, and resolving its mesh's "
+            f"transition_width = {w:g} needs {M} fine points per output sample (~{need / 2**20:.4g} MiB), "
+            f"more than the memory budget solver.memory_limit_MiB = {limit / 2**20:g}. Hint: widen "
+            f"{stage_key(stage, 'mesh')}.transition_width or raise solver.memory_limit_MiB"
+        )
     return M
 
 

@@ -14,10 +14,11 @@ import math
 import numpy as np
 
 from ..analysis.antialias import level_crossings
+from ..model.budget import OVERSAMPLING
 from ..physics.mesh import I_LU, I_Z1, mesh_breakpoint_phases, mesh_gap_series
 
-OVERSAMPLING = 4
-"""Fine points per output sample on which band-limited signals are evaluated before filtering."""
+__all__ = ["OVERSAMPLING", "CubicHermite", "integer_crossings", "is_band_limited", "mesh_jump_times"]
+
 
 BAND_LIMITED_SUFFIXES = ("_accel_rad_s2", "_accel_m_s2", "_bearing_force_x_N", "_bearing_force_y_N")
 """Signals replaced by their band-limited samples (accelerations, bearing and housing signals)."""

@@ -16,16 +16,19 @@ import exudyn.solver
 import numpy as np
 
 from ..assembly import (
+    check_resolved_modes,
     initial_state,
     mesh_frequency_hz,
     static_lateral_displacements_m,
     torsional_layout,
 )
-from ..errors import SimulationError
+from ..errors import GearbodyError, SimulationError
 from ..model import Scenario
+from ..model.budget import memory_limit_bytes
 from ..result import Result
 from .build import BuiltSystem, build_muller, build_torsional
 from .collect import collect
+from .hints import divergence_hint, mesh_range_hint, stall_hint
 
 SOLVER_TYPES = {
     name: getattr(exu.DynamicSolverType, name) for name in ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")
@@ -73,6 +76,7 @@ def build(scenario: Scenario) -> tuple[BuiltSystem, np.ndarray, np.ndarray]:
 def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
     """Simulate a scenario; raise :class:`SimulationError` on numerical failure."""
     wall0 = time.perf_counter()
+    check_resolved_modes(scenario)  # a mode far above what the run resolves: refused (exit 2)
     built, _, _ = build(scenario)
     build_s = time.perf_counter() - wall0
     mbs = built.mbs
@@ -80,23 +84,36 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
         watched = (1e3, "deflection rate", "m/s")
     else:
         watched = (100.0 * scenario.design.motor.synchronous_speed_rad_s, "motor speed", "rad/s")
-    built.watchdog.watch(scenario.operation.t_end_s, watched[0], progress, *watched[1:])
+    sv = scenario.solver
+    built.watchdog.watch(
+        scenario.operation.t_end_s,
+        watched[0],
+        progress,
+        *watched[1:],
+        wall_time_limit_s=sv.wall_time_limit_s,
+        memory_limit_bytes=memory_limit_bytes(scenario),
+        memory_limit_default=sv.memory_limit_MiB is None,
+        max_step_s=sv.max_step_s,
+        stall_hint=stall_hint(scenario),
+        divergence_hint=divergence_hint(scenario),
+    )
     settings = solver_settings(scenario)
     t_solve0 = time.perf_counter()
     exu.config.suppressWarnings = True  # min-step notices: gearbody checks the steps itself (_collect)
+    # Exudyn prints its "DYNAMIC SOLVER FAILED" banner itself when a run stops; gearbody says what
+    # happened in its own error instead (nothing else is printed by a run with verboseMode 0).
+    print_to_console = exu.config.printToConsole
+    exu.config.printToConsole = False
     # Python user functions allocate their return lists by design; Exudyn's allocation notice says so.
     exudyn.solver.solverCheckMemoryAllocationsThreshold = 2**62
     try:
-        exu.SolveDynamic(
-            mbs, settings, solverType=SOLVER_TYPES[scenario.solver.method], storeSolver=True, showHints=False
-        )
+        exu.SolveDynamic(mbs, settings, solverType=SOLVER_TYPES[sv.method], storeSolver=True, showHints=False)
     except Exception as exc:  # a user function raised (stall watchdog) or Exudyn failed
         if built.watchdog.failure:
             raise SimulationError(built.watchdog.failure) from None
-        message = str(exc)
-        last = message.strip().splitlines()[-1] if message.strip() else repr(exc)
-        raise SimulationError(f"Exudyn stopped: {last}") from exc
+        raise SimulationError(_failure_message(built.watchdog.t_max, exc)) from exc
     finally:
+        exu.config.printToConsole = print_to_console
         exu.config.suppressWarnings = False
         built.watchdog.close()
     solve_s = time.perf_counter() - t_solve0
@@ -108,6 +125,25 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
         {"build_wall_s": build_s, "solve_wall_s": solve_s, "wall_time_s": time.perf_counter() - wall0}
     )
     return result
+
+
+def _failure_message(t_s: float, exc: Exception) -> str:
+    """What a failed solve tells the user: where it stopped and what to change, without Exudyn's
+    internal text (its traceback and 'check your Python code') or Python reprs. A gearbody error
+    raised inside a force law keeps its own message."""
+    cause = exc.__cause__ or exc.__context__
+    where = f"the solver stopped at t = {t_s:.6g} s" if t_s >= 0 else "the solver stopped at its start"
+    if isinstance(cause, GearbodyError):
+        return f"{where}: {cause}"
+    if cause is not None:  # a force law raised (floating-point trouble in a compiled law, ...)
+        return (
+            f"{where}: a force law failed ({type(cause).__name__}). Hint: check for extreme stiffness, "
+            "inertia or load values, or tighten solver.absolute_tolerance / lower solver.max_step_s"
+        )
+    return (
+        f"{where}: Exudyn's explicit solver gave up ({type(exc).__name__}). Hint: tighten "
+        "solver.absolute_tolerance or lower solver.max_step_s"
+    )
 
 
 MAX_DEFLECTION_BASE_PITCH = 0.1
@@ -122,13 +158,12 @@ def _check_mesh_range(scenario: Scenario, result: Result) -> None:
         p_b = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
         if delta.max() > MAX_DEFLECTION_BASE_PITCH * p_b:
             m = int(np.argmax(delta > MAX_DEFLECTION_BASE_PITCH * p_b))
+            hint = mesh_range_hint(scenario, k, MAX_DEFLECTION_BASE_PITCH * p_b)
             raise SimulationError(
                 f"stage {k + 1}: the mesh deflection reached {delta[m] * 1e3:.3g} mm at t = "
                 f"{result.time_s[m]:.6g} s, more than {MAX_DEFLECTION_BASE_PITCH:g} of the base pitch "
                 f"({p_b * 1e3:.3g} mm): the lumped mesh model is outside its range (the gears ran "
-                "through each other). Hint: a tooth stiffness factor of 0 leaves no load path for a "
-                "whole mesh period in the lumped model; use a factor > 0 (e.g. 0.2), or check loads "
-                "and stiffnesses"
+                f"through each other). Hint: {hint}"
             )
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import time
 
 import numba
@@ -78,11 +79,27 @@ STALL_CALLS = 200_000  # force evaluations per stall check (~30k steps: ~0.1 s s
 STALL_ADVANCE_S = 1e-9
 
 
+PAGE_BYTES = os.sysconf("SC_PAGE_SIZE") if hasattr(os, "sysconf") else 4096
+
+
+def resident_memory_bytes() -> int:
+    """Resident memory of this process, bytes (Linux: /proc/self/statm; elsewhere the peak so far)."""
+    try:
+        with open("/proc/self/statm", "rb") as f:
+            return int(f.read().split()[1]) * PAGE_BYTES
+    except (OSError, IndexError, ValueError):
+        import resource
+
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+
 class StallWatchdog:
     """Rides on the drive's force function, which every step attempt evaluates (no pre-step Python call
-    per attempt): every CHECK_CALLS calls it checks the watched speed for divergence and draws the
-    progress bar; every STALL_CALLS calls it checks that time advanced (Exudyn's step control can reject
-    steps at the minimum step size forever). Hot force functions use :meth:`ticker`."""
+    per attempt): every CHECK_CALLS calls it checks the watched speed for divergence, the wall-time
+    limit, and draws the progress bar; every STALL_CALLS calls it checks that time advanced (Exudyn's
+    step control can reject steps at the minimum step size forever) and the memory limit (growth of the
+    process's resident memory while solving). Hot force functions use :meth:`ticker`."""
 
     def __init__(self) -> None:
         self.calls, self.t_check, self.t_max = 0, -1.0, -1.0
@@ -93,11 +110,43 @@ class StallWatchdog:
         self.progress = False
         self.bar = None
         self.t_wall0 = self.last_draw = 0.0
+        self.wall_time_limit_s = math.inf
+        self.memory_limit_bytes = math.inf
+        self.memory_limit_default = False
+        self.memory0_bytes = 0
+        self.max_step_s = math.inf
+        self.stall_hint = ""
+        self.divergence_hint = (
+            "check stiffness, inertia and load values, or tighten solver tolerances / lower solver.max_step_s"
+        )
 
-    def watch(self, t_end: float, speed_limit: float, progress: bool, name: str, unit: str) -> None:
-        """Set what the run watches: divergence above ``speed_limit`` of the watched speed, a progress bar."""
+    def watch(
+        self,
+        t_end: float,
+        speed_limit: float,
+        progress: bool,
+        name: str,
+        unit: str,
+        *,
+        wall_time_limit_s: float | None = None,
+        memory_limit_bytes: float | None = None,
+        memory_limit_default: bool = False,
+        max_step_s: float = math.inf,
+        stall_hint: str = "",
+        divergence_hint: str = "",
+    ) -> None:
+        """Set what the run watches: divergence above ``speed_limit`` of the watched speed, a progress
+        bar, the wall-time and memory budgets (None: unlimited), the largest step and the scenario's
+        likely causes of a stall or a divergence (hints for the messages)."""
         self.t_end, self.speed_limit, self.progress = t_end, speed_limit, progress
         self.speed_name, self.speed_unit = name, unit
+        self.wall_time_limit_s = math.inf if wall_time_limit_s is None else wall_time_limit_s
+        self.memory_limit_bytes = math.inf if memory_limit_bytes is None else memory_limit_bytes
+        self.memory_limit_default = memory_limit_default
+        self.max_step_s, self.stall_hint = max_step_s, stall_hint
+        self.divergence_hint = divergence_hint or self.divergence_hint
+        if memory_limit_bytes is not None:
+            self.memory0_bytes = resident_memory_bytes()
         self.t_wall0 = time.monotonic()
 
     def __call__(self, t: float, speed: float) -> None:
@@ -123,23 +172,35 @@ class StallWatchdog:
     def _check(self, t: float, speed: float) -> None:
         if not math.isfinite(speed) or abs(speed) > self.speed_limit:
             self.failure = (
-                f"state diverged at t = {t:.6g} s ({self.speed_name} {speed:.3g} {self.speed_unit}). Hint: "
-                "check stiffness, inertia and load values, or tighten solver tolerances / lower "
-                "solver.max_step_s"
+                f"state diverged at t = {t:.6g} s ({self.speed_name} {speed:.3g} {self.speed_unit}). "
+                f"Hint: {self.divergence_hint}"
+            )
+            raise StallError(self.failure)
+        now = time.monotonic()
+        if now - self.t_wall0 > self.wall_time_limit_s:
+            self.failure = (
+                f"stopped at t = {self.t_max:.6g} s of {self.t_end:g} s: the wall-time limit "
+                f"solver.wall_time_limit_s = {self.wall_time_limit_s:g} s was reached. Hint: raise "
+                "solver.wall_time_limit_s, shorten operation.t_end_s, or use solver.accuracy = 'draft'"
             )
             raise StallError(self.failure)
         if self.calls % STALL_CALLS == 0:
             if self.t_max - self.t_check < STALL_ADVANCE_S:
-                self.failure = (
-                    f"the solver stalled at t = {self.t_max:.9g} s: {STALL_CALLS} force evaluations "
-                    f"advanced less than {STALL_ADVANCE_S:g} s (step size collapse at a discontinuity, "
-                    "e.g. a tooth with stiffness factor 0 next to a loaded one). Hint: use a small "
-                    "non-zero stiffness factor, or loosen solver.relative_tolerance / absolute_tolerance"
-                )
-                raise StallError(self.failure)
+                raise StallError(self._stalled())
             self.t_check = self.t_max
+            if self.memory_limit_bytes < math.inf:
+                grown = resident_memory_bytes() - self.memory0_bytes
+                if grown > self.memory_limit_bytes:
+                    self.failure = (
+                        f"stopped at t = {self.t_max:.6g} s of {self.t_end:g} s: the run grew by "
+                        f"{grown / 2**20:.4g} MiB while solving, more than the memory budget "
+                        f"solver.memory_limit_MiB = {self.memory_limit_bytes / 2**20:g}"
+                        + (" (default)" if self.memory_limit_default else "")
+                        + ". Hint: every solver step is stored; shorten operation.t_end_s, loosen "
+                        "solver.absolute_tolerance (fewer steps), or raise solver.memory_limit_MiB"
+                    )
+                    raise StallError(self.failure)
         if self.progress:
-            now = time.monotonic()
             if self.bar is None and now - self.t_wall0 > 2.0:
                 from tqdm import tqdm
 
@@ -153,6 +214,26 @@ class StallWatchdog:
                 self.last_draw = now
                 self.bar.n = round(self.t_max, 6)
                 self.bar.refresh()
+
+    def _stalled(self) -> str:
+        what = (
+            f"the solver stalled at t = {self.t_max:.9g} s: {STALL_CALLS} force evaluations advanced "
+            f"less than {STALL_ADVANCE_S:g} s"
+        )
+        if self.max_step_s * STALL_CALLS < 100 * STALL_ADVANCE_S:  # the largest step itself is too short
+            self.failure = (
+                f"{what}: solver.max_step_s = {self.max_step_s:g} s caps every step. Hint: raise "
+                "solver.max_step_s (default 1e-4 s)"
+            )
+        elif self.stall_hint:
+            self.failure = f"{what} (step size collapse at a jump of the mesh law). Hint: {self.stall_hint}"
+        else:
+            self.failure = (
+                f"{what} (step size collapse at a discontinuity, e.g. a tooth with stiffness factor 0 "
+                "next to a loaded one). Hint: use a small non-zero stiffness factor, or loosen "
+                "solver.relative_tolerance / absolute_tolerance"
+            )
+        return self.failure
 
     def close(self) -> None:
         if self.bar is not None:

@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from .budget import check_resources
 from .components import Gear, Machine, Motor, Shaft
 from .faults import DamagedTooth, Eccentricity, ErrorMode, PittedTooth
 from .mesh import Mesh
@@ -131,6 +132,16 @@ class Solver(Node):
     anti_aliasing: bool = param(
         True, doc="band-limit force and acceleration signals before sampling (measurement-chain filter)"
     )
+    # Resource limits (gearbody.model.budget): checked before a run from estimates, and during it.
+    memory_limit_MiB: float | None = param(
+        None,
+        gt=0,
+        doc="memory budget of a run: refused before it when the output grid and stored steps are "
+        "estimated above it, stopped when the process grows by more while solving (unset: 2048)",
+    )
+    wall_time_limit_s: float | None = param(
+        None, gt=0, doc="stop a run cleanly after this much wall-clock time solving (unset: no limit)"
+    )
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -215,6 +226,7 @@ class Scenario(Node):
                 f"solver.output_rate_hz = {self.solver.output_rate_hz}: gives fewer than 2 "
                 f"samples over t_end_s = {self.operation.t_end_s}"
             )
+        check_resources(self)
 
     # -- derived quantities used everywhere ------------------------------------------------
     @property

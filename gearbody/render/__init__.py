@@ -17,17 +17,19 @@ from ..model import Scenario
 from ..result import Result
 from .layout import Layout, build_layout
 from .movie import FORMATS, ffmpeg_available, write_gif, write_mp4, write_png
-from .poses import RenderError, body_poses, frame_times, kinematic_result
+from .poses import MAX_FRAMES, RenderError, body_poses, check_frames, frame_times, kinematic_result
 from .scene3d import VIEWS, RenderOptions, has_display
 
 __all__ = [
     "FORMATS",
+    "MAX_FRAMES",
     "VIEWS",
     "Layout",
     "RenderError",
     "RenderOptions",
     "RenderOutput",
     "build_layout",
+    "check_frames",
     "check_result_matches",
     "kinematic_result",
     "render",
@@ -129,6 +131,7 @@ def render(
         raise RenderError(f"lateral_scale = {lateral_scale:g}: must lie in [0, 1e6]")
     options = options or RenderOptions()
     options.check()
+    check_frames(frames, options.width_px, options.height_px, movie)
     layout = build_layout(scenario)
     result = _motion(scenario, result)
     times = frame_times(result, frames, start_s, end_s)

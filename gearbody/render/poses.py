@@ -17,6 +17,25 @@ from ..errors import RenderError  # bad render request: option, value and what i
 from ..result import Result
 from .layout import Layout
 
+MAX_FRAMES = 2000
+"""Most frames of one render (each is a raytraced picture of ~0.1-1 s)."""
+GIF_LIMIT_BYTES = 2**30
+"""An animated GIF holds every frame in memory while it is written (width x height x 3 bytes each)."""
+
+
+def check_frames(frames: int, width_px: int, height_px: int, movie: str = "none") -> None:
+    """Refuse a frame count that cannot be rendered within the limits, before anything runs."""
+    if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_FRAMES:
+        raise RenderError(f"frames = {frames!r}: must be a whole number in [1, {MAX_FRAMES}]")
+    need = frames * width_px * height_px * 3
+    if movie == "gif" and need > GIF_LIMIT_BYTES:
+        most = GIF_LIMIT_BYTES // (width_px * height_px * 3)
+        raise RenderError(
+            f"frames = {frames} at {width_px}x{height_px}: an animated GIF holds every frame in memory "
+            f"({need / 2**20:.0f} MiB, limit {GIF_LIMIT_BYTES / 2**20:.0f} MiB); at this size at most "
+            f"{most} frames, or a smaller picture, or movie 'mp4' / 'none'"
+        )
+
 
 def frame_times(
     result: Result, frames: int, start_s: float | None = None, end_s: float | None = None
@@ -28,8 +47,8 @@ def frame_times(
     result's length); its first frame is one step after the window's start, so a looping animation
     does not show the same pose twice.
     """
-    if frames < 1:
-        raise RenderError(f"frames = {frames}: must be >= 1")
+    if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_FRAMES:
+        raise RenderError(f"frames = {frames!r}: must be a whole number in [1, {MAX_FRAMES}]")
     t = result.time_s
     t0, t1 = float(t[0]), float(t[-1])
     default_window = start_s is None
