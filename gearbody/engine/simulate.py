@@ -91,6 +91,8 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
             mbs, settings, solverType=SOLVER_TYPES[scenario.solver.method], storeSolver=True, showHints=False
         )
     except Exception as exc:  # a user function raised (stall watchdog) or Exudyn failed
+        if built.watchdog.interrupted:  # Ctrl-C inside a user function, reported by Exudyn as its error
+            raise KeyboardInterrupt from None
         if built.watchdog.failure:
             raise SimulationError(built.watchdog.failure) from None
         message = str(exc)

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import itertools
 import math
+import signal
+import threading
 import time
 
 import numba
@@ -82,7 +84,11 @@ class StallWatchdog:
     """Rides on the drive's force function, which every step attempt evaluates (no pre-step Python call
     per attempt): every CHECK_CALLS calls it checks the watched speed for divergence and draws the
     progress bar; every STALL_CALLS calls it checks that time advanced (Exudyn's step control can reject
-    steps at the minimum step size forever). Hot force functions use :meth:`ticker`."""
+    steps at the minimum step size forever). Hot force functions use :meth:`ticker`.
+
+    While it watches (from :meth:`watch` to :meth:`close`) it also notes a Ctrl-C (SIGINT) in
+    ``interrupted``: Exudyn turns a KeyboardInterrupt raised inside a user function into its own
+    error, and the caller re-raises KeyboardInterrupt from this flag."""
 
     def __init__(self) -> None:
         self.calls, self.t_check, self.t_max = 0, -1.0, -1.0
@@ -93,12 +99,31 @@ class StallWatchdog:
         self.progress = False
         self.bar = None
         self.t_wall0 = self.last_draw = 0.0
+        self.interrupted = False
+        self._sigint_handler = None
 
     def watch(self, t_end: float, speed_limit: float, progress: bool, name: str, unit: str) -> None:
         """Set what the run watches: divergence above ``speed_limit`` of the watched speed, a progress bar."""
         self.t_end, self.speed_limit, self.progress = t_end, speed_limit, progress
         self.speed_name, self.speed_unit = name, unit
         self.t_wall0 = time.monotonic()
+        self._note_interrupts()
+
+    def _note_interrupts(self) -> None:
+        """Chain a SIGINT handler that sets ``interrupted`` before the previous handler runs (only in the
+        main thread, and only where SIGINT is handled by Python: not where it is ignored)."""
+        if threading.current_thread() is not threading.main_thread() or self._sigint_handler is not None:
+            return
+        previous = signal.getsignal(signal.SIGINT)
+        if not callable(previous):  # SIG_IGN (a pool worker) or SIG_DFL: nothing raises in Python
+            return
+
+        def note(signum, frame):
+            self.interrupted = True
+            previous(signum, frame)
+
+        self._sigint_handler = previous
+        signal.signal(signal.SIGINT, note)
 
     def __call__(self, t: float, speed: float) -> None:
         self.calls += 1
@@ -155,6 +180,9 @@ class StallWatchdog:
                 self.bar.refresh()
 
     def close(self) -> None:
+        if self._sigint_handler is not None:
+            signal.signal(signal.SIGINT, self._sigint_handler)
+            self._sigint_handler = None
         if self.bar is not None:
             self.bar.n = self.bar.total
             self.bar.close()
