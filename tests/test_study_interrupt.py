@@ -210,3 +210,31 @@ def test_an_interrupted_and_worker_killed_study_resumes_to_the_uninterrupted_res
                 assert same, (case, name)
         sa, sb = (json.loads((d / "cases" / case / "summary.json").read_text()) for d in (out, ref))
         assert _without_wall_times(sa) == _without_wall_times(sb), case
+
+
+def _dask_task(what: str) -> dict:
+    if what == "kill":
+        os.kill(os.getpid(), signal.SIGKILL)  # the worker process dies; its nanny starts a new one
+    return {"ok": True, "value": what}
+
+
+@pytest.mark.slow
+def test_a_case_whose_dask_workers_die_is_failed_once_with_the_cause_and_the_others_run():
+    import cloudpickle
+    import dask
+    from dask.distributed import LocalCluster
+
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers need not import the tests
+    jobs = [(f"job-{i}", (w,)) for i, w in enumerate(["a", "kill", "b", "c"])]
+    # worker-saturation 1: a worker holds only the task it runs (Dask counts a death against every task
+    # the worker holds: with queued tasks, an innocent neighbour of the killer can fail too)
+    config = {"distributed.scheduler.allowed-failures": 1, "distributed.scheduler.worker-saturation": 1.0}
+    with dask.config.set(config), LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, host="127.0.0.1", dashboard_address=":0"
+    ) as cluster:
+        outcomes = list(executors.run_dask(_dask_task, jobs, cluster.scheduler_address))
+    assert sorted(jid for jid, _ in outcomes) == [jid for jid, _ in jobs]  # each job once
+    by_id = dict(outcomes)
+    assert by_id["job-1"]["ok"] is False and by_id["job-1"]["error_type"] == "KilledWorker"
+    assert by_id["job-1"]["message"].startswith("the Dask workers running this case died repeatedly: ")
+    assert all(by_id[j]["ok"] for j in ("job-0", "job-2", "job-3")), by_id
