@@ -238,3 +238,21 @@ def test_a_case_whose_dask_workers_die_is_failed_once_with_the_cause_and_the_oth
     assert by_id["job-1"]["ok"] is False and by_id["job-1"]["error_type"] == "KilledWorker"
     assert by_id["job-1"]["message"].startswith("the Dask workers running this case died repeatedly: ")
     assert all(by_id[j]["ok"] for j in ("job-0", "job-2", "job-3")), by_id
+
+
+def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path):
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "gearbody.cli", "run", SCENE, "--t-end", "20", "--no-plots"]
+    cmd += ["--out", str(out)]
+    proc = subprocess.Popen(cmd, env={**os.environ, "PYTHONPATH": str(ROOT)}, start_new_session=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    seen = b""
+    while b"simulating" not in seen:  # the progress bar: the solver has run for 2 s
+        chunk = proc.stderr.read1(4096)
+        assert chunk, (seen, proc.wait())
+        seen += chunk
+    os.killpg(proc.pid, signal.SIGINT)
+    rest = proc.stderr.read().decode()
+    assert proc.wait(timeout=30) == 130
+    assert rest.strip().splitlines()[-1] == "interrupted: gearbody run stopped" and "Traceback" not in rest
+    assert not (out / "result.npz").exists()
