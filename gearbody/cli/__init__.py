@@ -3,7 +3,7 @@
 One module per command (``register(sub)`` adds its parser, ``execute(args)`` runs it; heavy imports
 happen inside ``execute``), the shared options and exit codes in :mod:`.common`. Exit codes: 0 ok,
 1 something failed (validation, sweep cases), 2 bad input (invalid scenario or option), 3 simulation
-failed.
+failed, 130 interrupted (Ctrl-C: one line, no traceback).
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ import argparse
 import sys
 
 from . import listing, mesh, modes, render, run, sensitivity, sweep, validate
+from .common import EXIT_INTERRUPTED
 
 __all__ = ["main"]
 
@@ -58,3 +59,6 @@ def main(argv: list[str] | None = None) -> int:
         )
         print(f"gearbody: {kind}: {exc}", file=sys.stderr)
         return exc.exit_code
+    except KeyboardInterrupt as exc:  # a study says how far it got (StudyInterrupted)
+        print(str(exc) or f"interrupted: gearbody {args.command} stopped", file=sys.stderr)
+        return EXIT_INTERRUPTED

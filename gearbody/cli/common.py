@@ -9,6 +9,7 @@ from pathlib import Path
 
 __all__ = [
     "EXIT_FAILED",
+    "EXIT_INTERRUPTED",
     "EXIT_OK",
     "EXIT_SIMULATION",
     "EXIT_USAGE",
@@ -27,6 +28,8 @@ EXIT_USAGE = 2
 """Bad input: invalid scenario or option value (also argparse's own code)."""
 EXIT_SIMULATION = 3
 """The simulation failed (SimulationError)."""
+EXIT_INTERRUPTED = 130
+"""Stopped by Ctrl-C (SIGINT), as a shell reports a process killed by SIGINT (128 + 2)."""
 
 
 def add_set(parser: argparse.ArgumentParser, help: str) -> None:

@@ -1,11 +1,13 @@
 """``gearbody sweep SCENE``: a parameter study (:mod:`gearbody.studies`), resumable; exit 0 all cases
-ran, 1 some failed, 2 bad input."""
+ran, 1 some failed, 2 bad input, 130 interrupted (rerun to resume)."""
 
 from __future__ import annotations
 
 import argparse
 
 from .common import EXIT_FAILED, EXIT_OK, add_out, add_set, scenario_overrides, usage_error
+
+MAX_CASES = 10_000  # gearbody.studies.MAX_CASES (not imported here: heavy imports wait for execute)
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -18,8 +20,10 @@ def register(sub) -> argparse.ArgumentParser:
             "Run SCENE once per case of a study: the grid of the --vary lists, times --samples random "
             "draws of the --random keys, times meta.seed = 1..N of --seeds. Writes DIR/study.json, "
             "DIR/cases/<id>/ (result.npz, scenario.toml, summary.json, or error.json), DIR/summary.csv "
-            "and DIR/<value>_vs_<key>.png. Rerunning the same command on DIR resumes the study. Exit "
-            "code 0: all cases ran; 1: some failed; 2: bad input. See docs/sweep.md."
+            "and DIR/<value>_vs_<key>.png. Rerunning the same command on DIR resumes the study (after "
+            "Ctrl-C, or a killed run). A study has at most 10000 cases unless --max-cases allows more. "
+            "Exit code 0: all cases ran; 1: some failed; 2: bad input; 130: interrupted. See "
+            "docs/sweep.md."
         ),
         epilog="examples:\n"
         "  gearbody sweep one-stage --vary production.error_mode.e_um=0:20:5 --out runs/kd-vs-e\n"
@@ -49,6 +53,13 @@ def register(sub) -> argparse.ArgumentParser:
         "--study-seed", type=int, default=0, metavar="S", help="seed of the random draws (default 0)"
     )
     sw.add_argument("--seeds", type=int, metavar="N", help="vary meta.seed (random tooth errors) over 1..N")
+    sw.add_argument(
+        "--max-cases",
+        type=int,
+        default=MAX_CASES,
+        metavar="N",
+        help=f"refuse a study of more than N cases before anything runs (default {MAX_CASES})",
+    )
     add_set(sw, "fixed override of every case (as for run)")
     sw.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time of every case")
     sw.add_argument(
@@ -95,6 +106,7 @@ def execute(args) -> int:
             retry_failed=args.retry_failed,
             plot_value=args.plot_value,
             plot_key=args.plot_key,
+            max_cases=args.max_cases,
         )
     except (SweepSpecError, ImportError) as exc:
         return usage_error("sweep", str(exc))

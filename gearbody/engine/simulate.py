@@ -109,6 +109,8 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
     try:
         exu.SolveDynamic(mbs, settings, solverType=SOLVER_TYPES[sv.method], storeSolver=True, showHints=False)
     except Exception as exc:  # a user function raised (stall watchdog) or Exudyn failed
+        if built.watchdog.interrupted:  # Ctrl-C inside a user function, reported by Exudyn as its error
+            raise KeyboardInterrupt from None
         if built.watchdog.failure:
             raise SimulationError(built.watchdog.failure) from None
         raise SimulationError(_failure_message(built.watchdog.t_max, exc)) from exc

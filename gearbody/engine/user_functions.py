@@ -8,6 +8,8 @@ from __future__ import annotations
 import itertools
 import math
 import os
+import signal
+import threading
 import time
 
 import numba
@@ -99,7 +101,11 @@ class StallWatchdog:
     per attempt): every CHECK_CALLS calls it checks the watched speed for divergence, the wall-time
     limit, and draws the progress bar; every STALL_CALLS calls it checks that time advanced (Exudyn's
     step control can reject steps at the minimum step size forever) and the memory limit (growth of the
-    process's resident memory while solving). Hot force functions use :meth:`ticker`."""
+    process's resident memory while solving). Hot force functions use :meth:`ticker`.
+
+    While it watches (from :meth:`watch` to :meth:`close`) it also notes a Ctrl-C (SIGINT) in
+    ``interrupted``: Exudyn turns a KeyboardInterrupt raised inside a user function into its own
+    error, and the caller re-raises KeyboardInterrupt from this flag."""
 
     def __init__(self) -> None:
         self.calls, self.t_check, self.t_max = 0, -1.0, -1.0
@@ -119,6 +125,8 @@ class StallWatchdog:
         self.divergence_hint = (
             "check stiffness, inertia and load values, or tighten solver tolerances / lower solver.max_step_s"
         )
+        self.interrupted = False
+        self._sigint_handler = None
 
     def watch(
         self,
@@ -148,6 +156,23 @@ class StallWatchdog:
         if memory_limit_bytes is not None:
             self.memory0_bytes = resident_memory_bytes()
         self.t_wall0 = time.monotonic()
+        self._note_interrupts()
+
+    def _note_interrupts(self) -> None:
+        """Chain a SIGINT handler that sets ``interrupted`` before the previous handler runs (only in the
+        main thread, and only where SIGINT is handled by Python: not where it is ignored)."""
+        if threading.current_thread() is not threading.main_thread() or self._sigint_handler is not None:
+            return
+        previous = signal.getsignal(signal.SIGINT)
+        if not callable(previous):  # SIG_IGN (a pool worker) or SIG_DFL: nothing raises in Python
+            return
+
+        def note(signum, frame):
+            self.interrupted = True
+            previous(signum, frame)
+
+        self._sigint_handler = previous
+        signal.signal(signal.SIGINT, note)
 
     def __call__(self, t: float, speed: float) -> None:
         self.calls += 1
@@ -236,6 +261,9 @@ class StallWatchdog:
         return self.failure
 
     def close(self) -> None:
+        if self._sigint_handler is not None:
+            signal.signal(signal.SIGINT, self._sigint_handler)
+            self._sigint_handler = None
         if self.bar is not None:
             self.bar.n = self.bar.total
             self.bar.close()

@@ -12,19 +12,23 @@ A :class:`Study` is a scene (name or TOML path), fixed ``KEY=VALUE`` overrides a
 
 The cases are the product grid x samples x seeds, in that order (the first ``vary`` key outermost);
 each has a stable id (``case-0000``, ...) and a deterministic list of overrides. Every case is
-validated (its scenario loaded) before anything runs.
+validated (its scenario loaded) before anything runs; a study of more than ``MAX_CASES`` cases
+(10,000) is refused before any is made, unless ``max_cases`` (``--max-cases``) allows it.
 
 :func:`run_study` (:mod:`.runner`) runs the cases serially in-process, on a local process pool, or on
 a Dask distributed cluster (:mod:`.executors`). Exudyn systems cannot be pickled: every worker rebuilds
 its model from the scene's TOML data and the case's override strings (:mod:`.tasks`). Each finished
 case is written at once and atomically to ``OUT/cases/<id>/`` (:mod:`.store`: ``result.npz``,
 ``scenario.toml``, ``summary.json``, or ``error.json`` for a failed case); ``OUT/study.json`` holds the
-spec, so rerunning the same study on the same folder resumes it. At the end ``OUT/summary.csv``
+spec, so rerunning the same study on the same folder resumes it. Ctrl-C raises
+:class:`StudyInterrupted` (finished cases kept, the others unrecorded); a pool worker that dies fails
+only its own case, and the pool is restarted. At the end ``OUT/summary.csv``
 (:mod:`.table`) and ``OUT/<value>_vs_<key>.png`` are written. Spec parsing: :mod:`.parse` (``--vary``,
 ``--random``) and :mod:`.spec` (:class:`Study`, its cases). See docs/sweep.md.
 """
 
 from .parse import (
+    MAX_CASES,
     Axis,
     Distribution,
     RandomAxis,
@@ -33,19 +37,21 @@ from .parse import (
     parse_random,
     parse_vary,
 )
-from .runner import run_study
+from .runner import StudyInterrupted, run_study
 from .spec import Case, Study
 from .speed import SpeedSweep, kd_speed_sweep, steady_overrides
 from .table import StudyResult
 from .tasks import run_case
 
 __all__ = [
+    "MAX_CASES",
     "Axis",
     "Case",
     "Distribution",
     "RandomAxis",
     "SpeedSweep",
     "Study",
+    "StudyInterrupted",
     "StudyResult",
     "SweepSpecError",
     "kd_speed_sweep",

@@ -4,34 +4,57 @@ distributed cluster; one set of executors for parameter sweeps and K_d-against-s
 A job is ``(id, args)``; a task is a picklable module-level function ``task(*args) -> outcome`` that
 never raises (it returns :func:`failure` instead). Exudyn systems cannot be pickled: the tasks rebuild
 their model from plain TOML data and override strings. Every executor yields ``(id, outcome)`` as jobs
-finish (the pool and Dask in completion order); a worker that dies or cannot unpickle yields a
-:func:`failure` for its job.
+finish (the pool and Dask in completion order).
+
+Failures of the machinery are charged to the job that met them, and the others go on: a pool worker
+that dies (killed, crashed) fails only the job it was running, with its signal or exit code, and the
+pool is restarted for the rest; a Dask job whose workers died ``distributed.scheduler.allowed-failures``
+times (Dask reschedules it until then) fails with that cause. Ctrl-C (KeyboardInterrupt in the calling
+process) stops every executor promptly: pool workers ignore SIGINT and are terminated, Dask jobs are
+cancelled, and the KeyboardInterrupt propagates; jobs not yielded yet are simply not done.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import shutil
+import signal
+import tempfile
 import traceback
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from pathlib import Path
 from typing import Any
 
 from .parse import SweepSpecError
 
-__all__ = ["Job", "check_options", "dask", "failure", "run_dask", "run_jobs", "run_pool", "run_serial"]
+__all__ = [
+    "Job",
+    "WorkerDied",
+    "check_options",
+    "dask",
+    "death_cause",
+    "failure",
+    "run_dask",
+    "run_jobs",
+    "run_pool",
+    "run_serial",
+]
 
 Job = tuple[str, tuple]
 Task = Callable[..., dict[str, Any]]
 
 
-def failure(exc: BaseException, wall_s: float = math.nan) -> dict[str, Any]:
-    """The outcome of a failed job: ``{"ok": False, "error_type", "message", "traceback", "wall_time_s"}``."""
+def failure(exc: BaseException, wall_s: float = math.nan, message: str | None = None) -> dict[str, Any]:
+    """The outcome of a failed job: ``{"ok": False, "error_type", "message", "traceback", "wall_time_s"}``
+    (``message`` defaults to the exception's text)."""
     return {
         "ok": False,
         "error_type": type(exc).__name__,
-        "message": str(exc) or repr(exc),
+        "message": message or str(exc) or repr(exc),
         "traceback": "".join(traceback.format_exception(type(exc), exc, exc.__traceback__)),
         "wall_time_s": wall_s,
     }
@@ -42,19 +65,103 @@ def run_serial(task: Task, jobs: Sequence[Job]) -> Iterator[tuple[str, dict]]:
         yield jid, task(*args)
 
 
-def run_pool(task: Task, jobs: Sequence[Job], workers: int) -> Iterator[tuple[str, dict]]:
-    pool = ProcessPoolExecutor(max_workers=workers)
-    futures = {}
+MAX_UNCHARGED_RESTARTS = 3
+"""Pool restarts after a worker died between jobs (no job to charge) before the pending jobs fail."""
+
+
+class WorkerDied(RuntimeError):
+    """A pool worker process died (killed by a signal, crashed, or exited) while running a job."""
+
+
+def _ignore_sigint() -> None:
+    """Pool worker initializer: Ctrl-C reaches the whole process group; the parent stops the workers."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _marked(marks: str, task: Task, jid: str, args: tuple) -> dict[str, Any]:
+    """Run ``task(*args)`` in a pool worker with ``marks/<pid>`` naming the job while it runs (so the
+    parent can tell which job a dead worker was running)."""
+    mark = Path(marks) / str(os.getpid())
+    mark.write_text(jid)
     try:
-        futures = {pool.submit(task, *args): jid for jid, args in jobs}
-        for fut in as_completed(futures):
-            try:
-                outcome = fut.result()
-            except Exception as exc:  # the worker died (BrokenProcessPool) or could not unpickle
-                outcome = failure(exc)
-            yield futures[fut], outcome
+        return task(*args)
     finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+        mark.unlink(missing_ok=True)
+
+
+def death_cause(exitcode: int | None) -> str:
+    """``worker process died (signal 9, SIGKILL)`` or ``worker process exited with code 1``."""
+    if exitcode is not None and exitcode < 0:
+        try:
+            name = f", {signal.Signals(-exitcode).name}"
+        except ValueError:
+            name = ""
+        return f"worker process died (signal {-exitcode}{name})"
+    return f"worker process exited with code {exitcode}"
+
+
+def run_pool(
+    task: Task, jobs: Sequence[Job], workers: int, mark_dir: str | Path | None = None
+) -> Iterator[tuple[str, dict]]:
+    """On a local process pool of ``workers`` processes. A worker that dies fails the job it was
+    running (:class:`WorkerDied`, the message names the signal or exit code); the pool is restarted
+    for the other jobs. ``mark_dir`` holds ``<pid>`` files naming each worker's running job (default:
+    a temporary folder)."""
+    todo = dict(jobs)
+    marks = Path(mark_dir) if mark_dir is not None else Path(tempfile.mkdtemp(prefix="gearbody-pool-"))
+    marks.mkdir(parents=True, exist_ok=True)
+    uncharged = 0
+    try:
+        while todo:
+            pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)), initializer=_ignore_sigint)
+            futures: dict = {}
+            processes: list = []
+            broken = done = False
+            try:
+                for jid, args in todo.items():
+                    futures[pool.submit(_marked, str(marks), task, jid, args)] = jid
+                processes = list(getattr(pool, "_processes", {}).values())  # fork: all started by now
+                for fut in as_completed(futures):
+                    try:
+                        outcome = fut.result()
+                    except BrokenProcessPool:  # a worker died: which one, and running what, below
+                        broken = True
+                        break
+                    except Exception as exc:  # a result that cannot be unpickled
+                        outcome = failure(exc)
+                    del todo[futures[fut]]
+                    yield futures[fut], outcome
+                done = True
+            finally:
+                if not done:  # interrupted, closed early or broken: stop every worker now
+                    for p in processes:
+                        p.terminate()
+                pool.shutdown(wait=True, cancel_futures=True)
+            if not broken:
+                continue
+            for fut, jid in futures.items():  # finished before the break but not yielded yet
+                if jid in todo and fut.done() and not fut.cancelled() and fut.exception() is None:
+                    del todo[jid]
+                    yield jid, fut.result()
+            charged = 0
+            for p in processes:  # the pool terminated the survivors (SIGTERM) after one died
+                mark = marks / str(p.pid)
+                jid = mark.read_text() if mark.exists() else None
+                mark.unlink(missing_ok=True)
+                if p.exitcode in (None, 0, -signal.SIGTERM) or jid not in todo:
+                    continue
+                cause = death_cause(p.exitcode)
+                del todo[jid]
+                charged += 1
+                yield jid, failure(WorkerDied(cause), message=f"{cause} while running this case")
+            uncharged = 0 if charged else uncharged + 1
+            if uncharged > MAX_UNCHARGED_RESTARTS:
+                for jid in list(todo):
+                    del todo[jid]
+                    yield jid, failure(WorkerDied("the process pool broke repeatedly"))
+    finally:
+        if mark_dir is None:
+            shutil.rmtree(marks, ignore_errors=True)
 
 
 def dask():
@@ -91,7 +198,9 @@ def run_dask(
         for fut in distributed.as_completed(list(futures)):
             try:
                 outcome = fut.result()
-            except Exception as exc:  # KilledWorker, lost connection, ...
+            except distributed.KilledWorker as exc:  # its workers died allowed-failures times
+                outcome = failure(exc, message=f"the Dask workers running this case died repeatedly: {exc}")
+            except Exception as exc:  # lost connection, a result that cannot be unpickled, ...
                 outcome = failure(exc)
             yield futures[fut], outcome
             fut.release()
@@ -120,9 +229,11 @@ def run_jobs(
     workers: int | None = None,
     scheduler: Any | None = None,
     name: str = "gearbody-sweep",
+    mark_dir: str | Path | None = None,
 ) -> Iterator[tuple[str, dict]]:
     """Run ``task`` on every job, on ``scheduler`` (Dask) if given, else on ``workers`` local processes
-    (default ``os.cpu_count()``, at most one per job; 1: serially in this process)."""
+    (default ``os.cpu_count()``, at most one per job; 1: serially in this process). ``mark_dir``: see
+    :func:`run_pool`."""
     jobs = list(jobs)
     n_workers = min(workers or os.cpu_count() or 1, max(len(jobs), 1))
     if not jobs:
@@ -131,4 +242,4 @@ def run_jobs(
         return run_dask(task, jobs, scheduler, name)
     if n_workers == 1:
         return run_serial(task, jobs)
-    return run_pool(task, jobs, n_workers)
+    return run_pool(task, jobs, n_workers, mark_dir)

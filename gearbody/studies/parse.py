@@ -16,6 +16,7 @@ from gearbody.model import parse_override
 from ..errors import StudySpecError
 
 __all__ = [
+    "MAX_CASES",
     "Axis",
     "Distribution",
     "RandomAxis",
@@ -32,6 +33,11 @@ _KEY = re.compile(r"^[A-Za-z_][\w-]*(\.([A-Za-z_][\w-]*|[1-9][0-9]*))*$")  # lis
 _DIST = re.compile(r"^\s*(\w+)\s*\((.*)\)\s*$", re.DOTALL)
 _NUMBER = r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?"
 
+
+MAX_CASES = 10_000
+"""Most cases a study may have unless raised explicitly (``--max-cases``, ``max_cases=``): each case is
+a whole simulation (seconds of wall time), and a larger grid is far more likely a typing slip (an extra
+zero in a count) than a plan. Checked, like a range's count, before any value list is made."""
 
 SweepSpecError = StudySpecError
 """Invalid study input (syntax, conflicting options, a spec that differs from the one on disk); the
@@ -112,7 +118,7 @@ class Axis:
     """The argument it came from, for error messages (e.g. ``--vary production.error_mode.e_um=0:20:5``)."""
 
 
-def _range_texts(key: str, spec: str, label: str) -> list[str]:
+def _range_texts(key: str, spec: str, label: str, max_count: int) -> list[str]:
     parts = _split_top(spec, ":")
     if len(parts) != 3:
         raise SweepSpecError(
@@ -123,6 +129,11 @@ def _range_texts(key: str, spec: str, label: str) -> list[str]:
     if not re.fullmatch(r"\d+", parts[2]) or int(parts[2]) < 1:
         raise SweepSpecError(f"{label}: count must be a whole number >= 1, got {parts[2]!r}")
     count = int(parts[2])
+    if count > max_count:
+        raise SweepSpecError(
+            f"{label}: count {count} is more than the {max_count} cases a study may have; "
+            f"give --max-cases {count} (or more) to run it anyway"
+        )
     if count == 1 and start != stop:
         raise SweepSpecError(f"{label}: count 1 needs start == stop, got {spec!r}")
     values = np.linspace(start, stop, count)
@@ -132,14 +143,15 @@ def _range_texts(key: str, spec: str, label: str) -> list[str]:
     return [repr(float(f"{v:.15g}")) for v in values]  # 0.30000000000000004 -> 0.3
 
 
-def parse_vary(text: str, *, label: str | None = None) -> Axis:
-    """``KEY=start:stop:count`` (inclusive linspace) or ``KEY=v1,v2,...`` (TOML literals) -> Axis."""
+def parse_vary(text: str, *, label: str | None = None, max_count: int = MAX_CASES) -> Axis:
+    """``KEY=start:stop:count`` (inclusive linspace) or ``KEY=v1,v2,...`` (TOML literals) -> Axis; a
+    range of more than ``max_count`` values is refused before it is made."""
     label = label or f"--vary {text}"
     key, spec = _split_key(text, label, "production.error_mode.e_um=0:20:5 or ...=5,10,15")
     commas, colons = _split_top(spec, ","), _split_top(spec, ":")
     if len(commas) > 1 and len(colons) > 1:
         raise SweepSpecError(f"{label}: give either a range start:stop:count or a list v1,v2,..., not both")
-    texts = _range_texts(key, spec, label) if len(colons) > 1 else commas
+    texts = _range_texts(key, spec, label, max_count) if len(colons) > 1 else commas
     if any(not t for t in texts):
         raise SweepSpecError(f"{label}: empty value in the list {spec!r}")
     if len(set(texts)) != len(texts):

@@ -1,12 +1,15 @@
 """Running a parameter study (``gearbody sweep``): check the whole spec and every case before anything
 runs, resume what the output folder already holds, run the pending cases on an executor (serial,
 process pool or Dask), write each finished case at once, then ``OUT/summary.csv`` and the plot.
+Ctrl-C stops it promptly with :class:`StudyInterrupted`: the finished cases stay recorded, the running
+and pending ones stay unrecorded, so the same call resumes them.
 
 The package docstring (:mod:`gearbody.studies`) describes the study; docs/sweep.md the files.
 """
 
 from __future__ import annotations
 
+import shutil
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -16,12 +19,20 @@ from gearbody.plotting.study import plot_study
 
 from .executors import check_options, run_jobs
 from .parse import SweepSpecError
-from .spec import Study
+from .spec import MAX_CASES, Study
 from .store import case_state, prepare_out, write_case
 from .table import DEFAULT_PLOT_VALUE, StudyResult, check_plot_value, collect_rows, write_csv
 from .tasks import run_case
 
-__all__ = ["run_study"]
+__all__ = ["StudyInterrupted", "run_study"]
+
+
+class StudyInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a study: ``done`` of ``total`` cases are recorded; the same call resumes it."""
+
+    def __init__(self, done: int, total: int) -> None:
+        super().__init__(f"interrupted: {done} of {total} cases done; rerun the same command to resume")
+        self.done, self.total = done, total
 
 
 def run_study(
@@ -41,6 +52,7 @@ def run_study(
     retry_failed: bool = False,
     plot_value: str = DEFAULT_PLOT_VALUE,
     plot_key: str | None = None,
+    max_cases: int = MAX_CASES,
 ) -> StudyResult:
     """Run a parameter study, resuming whatever ``out_dir`` already holds of it.
 
@@ -56,8 +68,11 @@ def run_study(
         retry_failed: rerun cases that have an ``error.json``.
         plot_value: summary value to plot (default ``kd_max_final``).
         plot_key: varied key on the x axis (default: the first one).
+        max_cases: most cases the study may have (default :data:`~gearbody.studies.spec.MAX_CASES`).
     Raises:
-        SweepSpecError, ScenarioError: bad input, before anything runs.
+        SweepSpecError, ScenarioError: bad input (also more than ``max_cases`` cases), before anything
+            runs.
+        StudyInterrupted: Ctrl-C (a KeyboardInterrupt); the finished cases are recorded.
         ImportError: ``scheduler`` given but dask.distributed is not installed.
     """
     if isinstance(scene, Study):
@@ -73,6 +88,7 @@ def run_study(
             study_seed=study_seed,
             seeds=seeds,
             base_overrides=base_overrides,
+            max_cases=max_cases,
         )
     keys = study.keys
     plot_key = plot_key or keys[0]
@@ -97,14 +113,18 @@ def run_study(
 
     by_id = {c.id: c for c in pending}
     jobs = [(c.id, (study.base, c.overrides, save_results)) for c in pending]
-    runner = run_jobs(run_case, jobs, workers=workers, scheduler=scheduler)  # run_case looked up now
+    running = out / ".running"  # pool workers' <pid> files naming their case, while it runs
+    runner = run_jobs(run_case, jobs, workers=workers, scheduler=scheduler, mark_dir=running)
 
     from tqdm import tqdm
 
     failed = 0
     bar = None
+    recorded: set[str] = set()
     try:
         for cid, outcome in runner:
+            if cid in recorded:  # an executor never yields a case twice; never record one twice
+                continue
             if bar is None:  # created after the pool has started its processes
                 bar = tqdm(
                     total=len(jobs),
@@ -117,15 +137,19 @@ def run_study(
                 )
                 bar.set_postfix_str("0 failed", refresh=False)
             write_case(out / "cases" / cid, by_id[cid], scenarios[cid], outcome, save_results)
+            recorded.add(cid)
             failed += not outcome["ok"]
             bar.set_postfix_str(f"{failed} failed", refresh=False)
             bar.update(1)
+    except KeyboardInterrupt:
+        raise StudyInterrupted(skipped + len(recorded), len(cases)) from None
     finally:
         if bar is not None:
             bar.close()
         close = getattr(runner, "close", None)
         if close:
             close()
+        shutil.rmtree(running, ignore_errors=True)
 
     rows, summary_cols = collect_rows(out, cases, keys)
     columns = ["id", *keys, "status", *summary_cols, "error"]

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,6 +16,7 @@ from gearbody.model import Scenario, ScenarioError, parse_override
 from gearbody.model.io import load_scenario, read_toml
 
 from .parse import (
+    MAX_CASES,
     Axis,
     RandomAxis,
     SweepSpecError,
@@ -25,7 +27,7 @@ from .parse import (
     toml_value,
 )
 
-__all__ = ["SEED_KEY", "Case", "Study"]
+__all__ = ["MAX_CASES", "SEED_KEY", "Case", "Study"]
 
 SEED_KEY = "meta.seed"
 
@@ -82,6 +84,7 @@ class Study:
         study_seed: int = 0,
         seeds: int | None = None,
         base_overrides: Sequence[str] = (),
+        max_cases: int = MAX_CASES,
     ) -> Study:
         """Check and assemble a study.
 
@@ -94,11 +97,16 @@ class Study:
             study_seed: seed of the random draws.
             seeds: vary ``meta.seed`` over 1..seeds.
             base_overrides: fixed ``KEY=VALUE`` overrides of every case (``--set``).
+            max_cases: most cases allowed (default :data:`MAX_CASES`); checked before any is made.
         Raises:
-            SweepSpecError: bad syntax or conflicting options (the message names the argument).
+            SweepSpecError: bad syntax, conflicting options, or more than ``max_cases`` cases (the
+                message names the argument, the count and the limit).
             ScenarioError: unknown scene or bad scenario file.
         """
-        axes = _vary_axes(vary)
+        if isinstance(max_cases, bool) or int(max_cases) != max_cases or max_cases < 1:
+            raise SweepSpecError(f"--max-cases must be a whole number >= 1, got {max_cases!r}")
+        max_cases = int(max_cases)
+        axes = _vary_axes(vary, max_cases)
         rand = _random_axes(random)
         if rand and samples is None:
             raise SweepSpecError(f"{rand[0].label}: give the number of draws with --samples N")
@@ -114,6 +122,7 @@ class Study:
             raise SweepSpecError(
                 "nothing to vary: give at least one of --vary, --random (with --samples), --seeds"
             )
+        _check_size(axes, rand, int(samples or 0), int(seeds or 0), max_cases)
         seen: dict[str, str] = {}
         for a in (*axes, *rand):
             if a.key in seen:
@@ -210,6 +219,24 @@ class Study:
             raise ScenarioError(f"{where}{case.id} ({values}): {exc}") from None
 
 
+def _check_size(
+    axes: Sequence[Axis], rand: Sequence[RandomAxis], samples: int, seeds: int, max_cases: int
+) -> None:
+    """SweepSpecError if grid x samples x seeds exceeds ``max_cases`` (counted, nothing is made)."""
+    factors = [(a.label, len(a.texts)) for a in axes]
+    if rand:
+        factors.append((f"--samples {samples}", samples))
+    if seeds:
+        factors.append((f"--seeds {seeds}", seeds))
+    n_cases = math.prod(n for _, n in factors)
+    if n_cases > max_cases:
+        shown = " x ".join(f"{n} ({label})" for label, n in factors)
+        raise SweepSpecError(
+            f"the study has {n_cases} cases ({shown}), more than the limit of {max_cases}; "
+            f"give --max-cases {n_cases} to run it anyway"
+        )
+
+
 def _loads(base: dict[str, Any], overrides: list[str]) -> bool:
     try:
         load_scenario(base, overrides)
@@ -218,20 +245,24 @@ def _loads(base: dict[str, Any], overrides: list[str]) -> bool:
     return True
 
 
-def _vary_axes(vary: Mapping[str, Sequence[Any] | str] | Sequence[str] | None) -> tuple[Axis, ...]:
+def _vary_axes(
+    vary: Mapping[str, Sequence[Any] | str] | Sequence[str] | None, max_cases: int = MAX_CASES
+) -> tuple[Axis, ...]:
     if not vary:
         return ()
     if isinstance(vary, str):
         vary = [vary]
     if not isinstance(vary, Mapping):
-        return tuple(parse_vary(t) for t in vary)
+        return tuple(parse_vary(t, max_count=max_cases) for t in vary)
     axes = []
     for key, spec in vary.items():
         label = f"vary[{key!r}]"
         if isinstance(spec, str):
-            axes.append(parse_vary(f"{key}={spec}", label=label))
+            axes.append(parse_vary(f"{key}={spec}", label=label, max_count=max_cases))
             continue
         check_key(key, label)
+        if hasattr(spec, "__len__") and len(spec) > max_cases:
+            raise SweepSpecError(f"{label}: {len(spec)} values, more than the limit of {max_cases} cases")
         values = list(spec)
         if not values:
             raise SweepSpecError(f"{label}: no values")

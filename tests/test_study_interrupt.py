@@ -1,0 +1,258 @@
+"""Studies survive interruption and failure: Ctrl-C stops a study (exit 130, finished cases kept, the
+others unrecorded), a killed pool worker fails only its own case, a resume runs every case exactly once,
+and the results are bit-identical to an uninterrupted study; studies are bounded in size."""
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gearbody.cli import main
+from gearbody.cli import sweep as sweep_cli
+from gearbody.engine import simulate
+from gearbody.model import load_scenario
+from gearbody.studies import MAX_CASES, Study, SweepSpecError, executors, run_study
+
+SCENE = "two-wheel"
+E_UM = "production.error_mode.e_um"
+VARY = f"{E_UM}=1:8:8"
+T_END = "0.2"  # ~0.2 s wall per case: long enough to be interrupted or killed inside a case
+ROOT = Path(__file__).resolve().parents[1]
+MESSAGE = re.compile(r"^interrupted: (\d+) of 8 cases done; rerun the same command to resume$")
+
+
+# --- the engine -----------------------------------------------------------------------------------
+
+
+def test_ctrl_c_inside_the_solver_is_a_keyboard_interrupt_not_a_simulation_error():
+    simulate(load_scenario(SCENE, ["operation.t_end_s=0.01"]))  # compiled and warm
+    scenario = load_scenario(SCENE, ["operation.t_end_s=5.0"])  # ~5 s wall uninterrupted
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    t0 = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        simulate(scenario)
+    assert time.perf_counter() - t0 < 2.0  # promptly
+    timer.join()
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the watchdog's hook is gone
+
+
+# --- failure marking of the executors ---------------------------------------------------------------
+
+
+def _task(what: str) -> dict:
+    """A job that succeeds, is killed by SIGKILL, or exits (as a crashed worker would)."""
+    if what == "kill":
+        time.sleep(0.2)  # the other jobs are under way
+        os.kill(os.getpid(), signal.SIGKILL)
+    if what == "exit":
+        os._exit(3)
+    time.sleep(0.05)
+    return {"ok": True, "value": what, "pid": os.getpid()}
+
+
+def test_a_dead_pool_worker_fails_only_its_own_job_and_the_pool_restarts():
+    jobs = [(f"job-{i}", (w,)) for i, w in enumerate(["a", "kill", "b", "c", "exit", "d", "e", "f"])]
+    outcomes = list(executors.run_pool(_task, jobs, workers=2))
+    ids = [jid for jid, _ in outcomes]
+    assert sorted(ids) == sorted(jid for jid, _ in jobs)  # every job exactly once
+    by_id = dict(outcomes)
+    assert by_id["job-1"]["ok"] is False and by_id["job-1"]["error_type"] == "WorkerDied"
+    assert by_id["job-1"]["message"] == "worker process died (signal 9, SIGKILL) while running this case"
+    assert by_id["job-4"]["message"] == "worker process exited with code 3 while running this case"
+    ok = {jid: o for jid, o in outcomes if jid not in ("job-1", "job-4")}
+    # a broken ProcessPoolExecutor runs nothing more: the jobs after a death ran on a restarted pool
+    assert all(o["ok"] and o["value"] == dict(jobs)[jid][0] for jid, o in ok.items())
+
+
+def test_death_causes_name_the_signal_or_the_exit_code():
+    assert executors.death_cause(-signal.SIGSEGV) == "worker process died (signal 11, SIGSEGV)"
+    assert executors.death_cause(1) == "worker process exited with code 1"
+
+
+# --- size of a study -------------------------------------------------------------------------------
+
+
+def test_a_study_too_big_is_refused_before_anything_is_made(tmp_path, capsys):
+    t0 = time.perf_counter()
+    with pytest.raises(SweepSpecError, match=rf"count 1000000000 is more than the {MAX_CASES} cases"):
+        Study.build(SCENE, vary=[f"{E_UM}=0:20:1000000000"])
+    with pytest.raises(SweepSpecError, match=r"has 1000000000000 cases \(1000000 \(--samples 1000000\) "
+                       rf"x 1000000 \(--seeds 1000000\)\), more than the limit of {MAX_CASES}"):
+        Study.build(SCENE, random=[f"{E_UM}=uniform(5,15)"], samples=10**6, seeds=10**6)
+    with pytest.raises(SweepSpecError, match=r"has 10100 cases .*--max-cases 10100"):
+        Study.build(SCENE, vary=[f"{E_UM}=0:20:101"], seeds=100)
+    assert time.perf_counter() - t0 < 5.0
+    assert len(Study.build(SCENE, vary=[f"{E_UM}=0:20:101"], seeds=100, max_cases=10100).cases()) == 10100
+    with pytest.raises(SweepSpecError, match=r"--max-cases must be a whole number >= 1, got 0"):
+        Study.build(SCENE, seeds=2, max_cases=0)
+    with pytest.raises(SweepSpecError, match=r"20 values, more than the limit of 10 cases"):
+        Study.build(SCENE, vary={E_UM: list(range(20))}, max_cases=10)
+    base = ["sweep", SCENE, "--workers", "1", "--quiet", "--out", str(tmp_path / "big")]
+    assert main([*base, "--seeds", "20", "--max-cases", "10"]) == 2
+    assert "the study has 20 cases (20 (--seeds 20)), more than the limit of 10" in capsys.readouterr().err
+    assert not (tmp_path / "big").exists()
+    assert sweep_cli.MAX_CASES == MAX_CASES
+
+
+# --- the command line: interrupt, kill a worker, resume ----------------------------------------------
+
+
+def _sweep(out: Path, *extra: str) -> subprocess.Popen:
+    cmd = [sys.executable, "-m", "gearbody.cli", "sweep", SCENE, "--vary", VARY, "--t-end", T_END]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    return subprocess.Popen(  # its own process group: a Ctrl-C reaches it and its workers only
+        [*cmd, *extra, "--out", str(out)],
+        env=env, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+
+
+def _wait(until, proc: subprocess.Popen, timeout_s: float = 60.0):
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout_s:
+        got = until()
+        if got:
+            return got
+        assert proc.poll() is None, proc.communicate()
+        time.sleep(0.01)
+    raise AssertionError("timed out")
+
+
+def _without_wall_times(data):
+    """JSON data without its wall-clock entries (``*wall_s``, ``wall_time_s``): all else is compared."""
+    if isinstance(data, dict):
+        return {k: _without_wall_times(v) for k, v in data.items() if "wall" not in k}
+    return data
+
+
+def _records(out: Path) -> dict[str, tuple[str, int]]:
+    """case id -> (state, mtime_ns of its record)."""
+    recs = {}
+    for name, state in (("summary.json", "ok"), ("error.json", "failed")):
+        for f in out.glob(f"cases/*/{name}"):
+            recs[f.parent.name] = (state, f.stat().st_mtime_ns)
+    return recs
+
+
+def test_an_interrupted_and_worker_killed_study_resumes_to_the_uninterrupted_results(tmp_path):
+    out = tmp_path / "study"
+    # 1. Ctrl-C during a serial study, once some cases are recorded
+    proc = _sweep(out, "--workers", "1")
+    _wait(lambda: len(_records(out)) >= 2, proc)
+    time.sleep(0.07)  # into the next case's solver (~0.01 s build, ~0.14 s solve)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    done = int(MESSAGE.match(err.strip().splitlines()[-1]).group(1))
+    first = _records(out)
+    assert 2 <= done < 8 and len(first) == done and {s for s, _ in first.values()} == {"ok"}
+    assert not list(out.glob("cases/*/error.json"))  # the interrupted case is not recorded as failed
+
+    # 2. resume on a process pool, kill -9 the worker of a running case
+    proc = _sweep(out, "--workers", "2")
+    running = out / ".running"
+
+    def busy_worker():
+        for mark in running.glob("*") if running.exists() else ():
+            try:
+                case = mark.read_text()
+            except FileNotFoundError:
+                continue
+            if case and not (out / "cases" / case / "summary.json").exists():
+                return int(mark.name), case
+        return None
+
+    pid, killed = _wait(busy_worker, proc)
+    os.kill(pid, signal.SIGKILL)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 1, err  # some case failed: the killed one
+    assert f"resuming {out}: {done} of 8 cases already done" in err and "Traceback" not in err
+    second = _records(out)
+    assert [c for c, (s, _) in second.items() if s == "failed"] == [killed]
+    error = json.loads((out / "cases" / killed / "error.json").read_text())
+    assert error["message"] == "worker process died (signal 9, SIGKILL) while running this case"
+    assert len(second) == 8 and all(second[c] == first[c] for c in first)  # phase 1 untouched
+
+    # 3. rerun the killed case
+    proc = _sweep(out, "--workers", "2", "--retry-failed")
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    third = _records(out)
+    assert {c for c in third if third[c] != second[c]} == {killed}  # only the killed case ran again
+    assert {s for s, _ in third.values()} == {"ok"} and not running.exists()
+
+    # every case was recorded by exactly one run, and all match an uninterrupted study bit for bit
+    runs = [set(first), set(second) - set(first) - {killed}, {killed}]
+    assert sum(len(r) for r in runs) == 8 and set().union(*runs) == set(third)
+    ref = tmp_path / "ref"
+    run_study(SCENE, out_dir=ref, vary=[VARY], base_overrides=[f"operation.t_end_s={float(T_END)!r}"],
+              workers=1, progress=False)
+    for case in sorted(third):
+        with np.load(out / "cases" / case / "result.npz") as a, np.load(ref / "cases" / case /
+                                                                        "result.npz") as b:
+            assert sorted(a.files) == sorted(b.files)
+            for name in a.files:
+                if name == "meta_json":
+                    same = _without_wall_times(json.loads(str(a[name]))) == _without_wall_times(
+                        json.loads(str(b[name]))
+                    )
+                else:
+                    same = np.array_equal(a[name], b[name]) and a[name].dtype == b[name].dtype
+                assert same, (case, name)
+        sa, sb = (json.loads((d / "cases" / case / "summary.json").read_text()) for d in (out, ref))
+        assert _without_wall_times(sa) == _without_wall_times(sb), case
+
+
+def _dask_task(what: str) -> dict:
+    if what == "kill":
+        os.kill(os.getpid(), signal.SIGKILL)  # the worker process dies; its nanny starts a new one
+    return {"ok": True, "value": what}
+
+
+@pytest.mark.slow
+def test_a_case_whose_dask_workers_die_is_failed_once_with_the_cause_and_the_others_run():
+    import cloudpickle
+    import dask
+    from dask.distributed import LocalCluster
+
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers need not import the tests
+    jobs = [(f"job-{i}", (w,)) for i, w in enumerate(["a", "kill", "b", "c"])]
+    # worker-saturation 1: a worker holds only the task it runs (Dask counts a death against every task
+    # the worker holds: with queued tasks, an innocent neighbour of the killer can fail too)
+    config = {"distributed.scheduler.allowed-failures": 1, "distributed.scheduler.worker-saturation": 1.0}
+    with dask.config.set(config), LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, host="127.0.0.1", dashboard_address=":0"
+    ) as cluster:
+        outcomes = list(executors.run_dask(_dask_task, jobs, cluster.scheduler_address))
+    assert sorted(jid for jid, _ in outcomes) == [jid for jid, _ in jobs]  # each job once
+    by_id = dict(outcomes)
+    assert by_id["job-1"]["ok"] is False and by_id["job-1"]["error_type"] == "KilledWorker"
+    assert by_id["job-1"]["message"].startswith("the Dask workers running this case died repeatedly: ")
+    assert all(by_id[j]["ok"] for j in ("job-0", "job-2", "job-3")), by_id
+
+
+def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path):
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "gearbody.cli", "run", SCENE, "--t-end", "20", "--no-plots"]
+    cmd += ["--out", str(out)]
+    proc = subprocess.Popen(cmd, env={**os.environ, "PYTHONPATH": str(ROOT)}, start_new_session=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    seen = b""
+    while b"simulating" not in seen:  # the progress bar: the solver has run for 2 s
+        chunk = proc.stderr.read1(4096)
+        assert chunk, (seen, proc.wait())
+        seen += chunk
+    os.killpg(proc.pid, signal.SIGINT)
+    rest = proc.stderr.read().decode()
+    assert proc.wait(timeout=30) == 130
+    assert rest.strip().splitlines()[-1] == "interrupted: gearbody run stopped" and "Traceback" not in rest
+    assert not (out / "result.npz").exists()
