@@ -167,7 +167,8 @@ def translate_key(path: list[str], data: dict[str, Any]) -> tuple[list[str], dic
     """A dotted override key on a canonical dict: a shorthand key becomes its stage-1 (or shaft) key
     when the drive has one stage; (new path, alias for messages). Refused on longer trains."""
     if len(path) >= 2 and path[0] in CANONICAL_KEYS:
-        _refuse_unknown({t: ({path[1]: None} if t == path[0] else None) for t in CANONICAL_KEYS}, "--set")
+        tables = {t: ({path[1]: None} if t == path[0] else None) for t in CANONICAL_KEYS}
+        _refuse_unknown(tables, ".".join(path))
     if len(path) < 2 or (path[0], path[1]) not in (*STAGE_KEYS, *SHAFT_KEYS):
         return path, {}
     key = (path[0], path[1])
