@@ -52,9 +52,13 @@ def main(argv: list[str] | None = None) -> int:
         return args.handler(args)
     except GearbodyError as exc:  # recognised by type: each error class carries its exit code
         kind = (
-            "invalid scenario" if isinstance(exc, ScenarioError)
-            else "simulation failed" if isinstance(exc, SimulationError)
-            else "invalid input" if exc.exit_code == 2 else "failed"
+            "invalid scenario"
+            if isinstance(exc, ScenarioError)
+            else "simulation failed"
+            if isinstance(exc, SimulationError)
+            else "invalid input"
+            if exc.exit_code == 2
+            else "failed"
         )
         print(f"gearbody: {kind}: {exc}", file=sys.stderr)
         return exc.exit_code
