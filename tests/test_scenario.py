@@ -196,3 +196,21 @@ def test_two_entries_for_the_same_damaged_tooth_are_refused():
     assert "design.stages.2.damaged_teeth.3: one entry per damaged tooth" in msg
     ok = load_scenario("one-stage", [f'condition.damaged_teeth=[{entry},{{gear="wheel",tooth=4}}]'])
     assert [(t.gear, t.tooth) for t in ok.stages[0].damaged_teeth] == [("pinion", 4), ("wheel", 4)]
+
+
+def test_a_shorthand_override_after_a_section_replaced_by_a_non_table_is_an_input_error():
+    # found by tests/test_fuzz_inputs.py: an AttributeError before
+    assert "meta = []: must be a table" in refused("one-stage", "meta=[]", "condition.damaged_teeth=")
+    assert "design = 1: must be a table" in refused("one-stage", "design=1", "production.error_mode.e_um=1")
+    msg = refused("one-stage", "design.stages=2", "production.error_mode.e_um=1")
+    assert "design.stages = 2: must be a list" in msg
+
+
+def test_a_bore_outside_the_root_circle_or_overflowing_the_stiffness_is_an_input_error():
+    # found by tests/test_fuzz_inputs.py: accepted (1000 mm) or an OverflowError (6e-299 mm) before
+    key = "design.mesh.geometry.bore_diameter_pinion_mm"
+    assert f"{key} = 1000: must be < the pinion's root diameter 132.5 mm" in refused(
+        "one-stage-geometry", f"{key}=1000"
+    )
+    with pytest.warns(UserWarning, match="outside the Sainsot fit range"):
+        assert "potential-energy stiffness overflows" in refused("one-stage-geometry", f"{key}=6e-299")

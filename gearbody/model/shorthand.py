@@ -172,9 +172,14 @@ def translate_key(path: list[str], data: dict[str, Any]) -> tuple[list[str], dic
     if len(path) < 2 or (path[0], path[1]) not in (*STAGE_KEYS, *SHAFT_KEYS):
         return path, {}
     key = (path[0], path[1])
-    stages = data.get("design", {}).get("stages") or []
+    design, meta = data.get("design", {}), data.get("meta")
+    if not isinstance(design, dict):
+        raise ScenarioError(f"{'.'.join(path)}: design = {design!r}: must be a table")
+    stages = design.get("stages") or []
+    if not isinstance(stages, list):
+        raise ScenarioError(f"{'.'.join(path)}: design.stages = {stages!r}: must be a list of stages")
     n = len(stages)
-    topology = data.get("meta", {}).get("topology")
+    topology = meta.get("topology") if isinstance(meta, dict) else None
     dotted = ".".join(path)
     if key in SHAFT_KEYS and topology != "train":
         raise ScenarioError(
