@@ -47,8 +47,11 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     from gearbody.errors import GearbodyError, ScenarioError, SimulationError
 
+    from .common import check_options
+
     args = _parser().parse_args(argv)
     try:
+        check_options(args)
         return args.handler(args)
     except GearbodyError as exc:  # recognised by type: each error class carries its exit code
         kind = (

@@ -10,15 +10,18 @@ import os
 import sys
 import tempfile
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = [
     "EXIT_FAILED",
+    "OutOfRange",
     "EXIT_OK",
     "EXIT_SIMULATION",
     "EXIT_USAGE",
     "add_out",
     "add_set",
+    "check_options",
     "check_out",
     "default_out",
     "load",
@@ -115,29 +118,47 @@ def check_out(path: Path, option: str = "--out") -> Path:
     return path
 
 
+@dataclass(frozen=True)
+class OutOfRange:
+    """An option's value that parsed but lies outside its range (refused by :func:`check_options`)."""
+
+    text: str
+    allowed: str
+
+
 def number(
     *,
     whole: bool = False,
     ge: float | None = None,
     gt: float | None = None,
     le: float | None = None,
-) -> Callable[[str], float]:
+) -> Callable[[str], float | OutOfRange]:
     """An argparse ``type``: the option's text as a finite float (or an int with ``whole``) in the
-    range; otherwise argparse's usage error (exit 2) stating the range and the text given."""
+    range. Text that is no number is argparse's usage error; a number out of range (NaN and
+    infinities included) is kept as :class:`OutOfRange` and refused by :func:`check_options`, before
+    the command runs, as ``--option = value: must be ...`` (exit 2)."""
     parts = [f">= {ge:g}" if ge is not None else "", f"> {gt:g}" if gt is not None else ""]
     parts.append(f"<= {le:g}" if le is not None else "")
     bounds = " and ".join(p for p in parts if p)
     what = ("a whole number" if whole else "a finite number") + (f" {bounds}" if bounds else "")
 
-    def convert(text: str) -> float:
+    def convert(text: str) -> float | OutOfRange:
         try:
             value = int(text) if whole else float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}") from None
         ok = math.isfinite(value) and (ge is None or value >= ge) and (gt is None or value > gt)
-        if not (ok and (le is None or value <= le)):
-            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}")
-        return value
+        return value if ok and (le is None or value <= le) else OutOfRange(text.strip(), what)
 
     convert.__name__ = "whole number" if whole else "number"  # argparse names the type in messages
     return convert
+
+
+def check_options(args: argparse.Namespace) -> None:
+    """InputError naming the first option whose value is out of its range (see :func:`number`)."""
+    from gearbody.errors import InputError
+
+    for dest, value in vars(args).items():
+        if isinstance(value, OutOfRange):
+            option = "--" + dest.replace("_", "-")
+            raise InputError(f"{option} = {value.text}: must be {value.allowed}")

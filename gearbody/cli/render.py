@@ -69,18 +69,8 @@ def register(sub) -> argparse.ArgumentParser:
     rd.add_argument(
         "--fps", type=number(ge=0.1, le=120), default=20.0, help="movie frames per second (default 20)"
     )
-    rd.add_argument(
-        "--width",
-        type=number(whole=True, ge=16, le=8192),
-        default=800,
-        help="image width in pixels (default 800)",
-    )
-    rd.add_argument(
-        "--height",
-        type=number(whole=True, ge=16, le=8192),
-        default=600,
-        help="image height in pixels (default 600)",
-    )
+    rd.add_argument("--width", type=int, default=800, help="image width in pixels (default 800)")
+    rd.add_argument("--height", type=int, default=600, help="image height in pixels (default 600)")
     rd.add_argument("--view", default="iso", help="camera preset: iso, front, back, side, top (default iso)")
     rd.add_argument(
         "--azimuth", type=number(), metavar="DEG", help="camera azimuth about the vertical, overrides --view"
