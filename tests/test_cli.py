@@ -266,3 +266,29 @@ def test_override_errors_on_the_command_line_quote_the_override(capsys):
     err = capsys.readouterr().err
     assert err.startswith("gearbody: invalid scenario: --set production.error_mode.e_um=abc (on ")
     assert "(any value)" not in err
+
+
+def test_scenario_paths_that_are_no_toml_file_are_one_line_exit_2_for_every_command(tmp_path, capsys):
+    binary = tmp_path / "drive.toml"
+    binary.write_bytes(b"\x8c\xff binary")
+    out = str(tmp_path / "out")
+    for scene, reason in ((tmp_path, "is a folder"), (binary, "not UTF-8 text")):
+        for command in (
+            ["run", str(scene), "--out", out],
+            ["modes", str(scene)],
+            ["mesh", str(scene), "--out", out],
+            ["render", str(scene), "--kinematic", "--out", out],
+            ["sweep", str(scene), "--seeds", "2", "--out", out],
+        ):
+            assert main(command) == 2
+            err = capsys.readouterr().err
+            assert err.count("\n") == 1 and f"{scene}: " in err and reason in err, command
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["drive.toml"]
+
+
+def test_render_result_that_is_no_gearbody_result_is_refused(tmp_path, capsys):
+    np.savez(tmp_path / "other.npz", a=np.zeros(2))
+    (tmp_path / "zip.npz").write_bytes(b"PK\x03\x04 broken")
+    for name in ("other.npz", "zip.npz"):
+        assert main(["render", "one-stage", "--result", str(tmp_path / name), "--out", str(tmp_path)]) == 2
+        assert f"{name} is not a result written by 'gearbody run'" in capsys.readouterr().err

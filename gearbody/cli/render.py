@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import time
+import zipfile
 from pathlib import Path
 
 from .common import (
@@ -152,7 +153,12 @@ def execute(args) -> int:
                 raise RenderError(
                     f"--result = {args.result}: no result.npz there (write one with 'gearbody run')"
                 )
-            result = Result.load_npz(path)
+            try:
+                result = Result.load_npz(path)
+            except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):  # not gearbody's npz
+                raise RenderError(
+                    f"--result = {args.result}: {path.name} is not a result written by 'gearbody run'"
+                ) from None
         elif args.kinematic:
             result = None
         else:

@@ -50,8 +50,8 @@ def _resolve_scene(scene: str | Path) -> tuple[str, Path]:
     path = Path(scene)
     if not path.suffix and not path.exists():
         return str(scene), scene_path(str(scene))
-    if not path.is_file():
-        raise ScenarioError(f"{path}: no such scenario file")
+    if not path.exists():
+        raise ScenarioError(f"{path}: no such scenario file")  # a folder or binary: read_toml says so
     return str(path.resolve()), path
 
 
