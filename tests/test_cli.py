@@ -254,6 +254,7 @@ def test_a_misspelled_scene_fails_before_any_output(capsys, tmp_path):
         ["mesh", "--out", out_dir],
         ["run", "--out", out_dir],
         ["render", "--kinematic"],
+        ["sweep", "--seeds", "2", "--out", out_dir],
     ):
         assert main([command[0], "one-stgae", *command[1:]]) == 2
         out, err = capsys.readouterr()
