@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from gearbody.cli import main
+from gearbody.errors import InputError
 from gearbody.model import load_scenario
 
 
@@ -166,11 +167,21 @@ def test_out_on_a_read_only_mount_is_refused_before_the_simulation(tmp_path):
 
 
 def test_out_in_a_writable_or_new_folder_is_accepted_and_the_probe_leaves_nothing(tmp_path):
+    import os
+
     from gearbody.cli.common import check_out
 
     assert check_out(tmp_path / "a" / "b") == tmp_path / "a" / "b"
     assert check_out(tmp_path) == tmp_path
     assert list(tmp_path.iterdir()) == []
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o555)
+    if os.geteuid() == 0:  # root writes there anyway, so the check agrees: it tries, it does not guess
+        assert check_out(locked / "x") == locked / "x"
+        (locked / "y").mkdir()
+    else:
+        with pytest.raises(InputError, match="cannot write in .*: Permission denied"):
+            check_out(locked / "x")
 
 
 BAD_OPTIONS = [
