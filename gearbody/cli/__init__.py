@@ -48,14 +48,21 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     from gearbody.errors import GearbodyError, ScenarioError, SimulationError
 
+    from .common import check_options
+
     args = _parser().parse_args(argv)
     try:
+        check_options(args)
         return args.handler(args)
     except GearbodyError as exc:  # recognised by type: each error class carries its exit code
         kind = (
-            "invalid scenario" if isinstance(exc, ScenarioError)
-            else "simulation failed" if isinstance(exc, SimulationError)
-            else "invalid input" if exc.exit_code == 2 else "failed"
+            "invalid scenario"
+            if isinstance(exc, ScenarioError)
+            else "simulation failed"
+            if isinstance(exc, SimulationError)
+            else "invalid input"
+            if exc.exit_code == 2
+            else "failed"
         )
         print(f"gearbody: {kind}: {exc}", file=sys.stderr)
         return exc.exit_code

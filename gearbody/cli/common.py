@@ -1,22 +1,33 @@
-"""What the commands share: the ``--set`` and ``--out`` options, scenario loading with the overrides,
-the default output folder ``runs/<scene>/...`` and the exit codes."""
+"""What the commands share: the ``--set`` and ``--out`` options, the check of an output folder, the
+types of numeric options (ranges checked when the command line is read), scenario loading with the
+overrides, the default output folder ``runs/<scene>/...`` and the exit codes."""
 
 from __future__ import annotations
 
 import argparse
+import math
+import os
 import sys
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = [
     "EXIT_FAILED",
     "EXIT_INTERRUPTED",
+    "OutOfRange",
     "EXIT_OK",
     "EXIT_SIMULATION",
     "EXIT_USAGE",
     "add_out",
     "add_set",
+    "check_options",
+    "check_out",
     "default_out",
     "load",
+    "number",
+    "scenario_labels",
     "scenario_overrides",
     "usage_error",
 ]
@@ -52,11 +63,22 @@ def scenario_overrides(args) -> list[str]:
     return overrides
 
 
-def load(scene: str, overrides: list[str]):
-    """The scenario of a scene name or TOML path with the overrides (ScenarioError if invalid)."""
+def scenario_labels(args) -> list[str]:
+    """How the user typed each of :func:`scenario_overrides` (``--set KEY=VALUE``, ``--t-end X``)."""
+    from gearbody.model.io import override_label
+
+    labels = [override_label(o) for o in args.overrides]
+    if args.t_end is not None:
+        labels.append(f"--t-end {args.t_end!r}")
+    return labels
+
+
+def load(scene: str, overrides: list[str], labels: list[str] | None = None):
+    """The scenario of a scene name or TOML path with the overrides (ScenarioError if invalid, naming
+    the override as typed: ``labels``, one per override, default ``--set KEY=VALUE``)."""
     from gearbody.model import load_scenario
 
-    return load_scenario(scene, overrides)
+    return load_scenario(scene, overrides, labels)
 
 
 def default_out(scene: str, *parts: str) -> Path:
@@ -69,3 +91,77 @@ def usage_error(command: str, message: str) -> int:
     """Print ``gearbody <command>: <message>`` on stderr; returns EXIT_USAGE."""
     print(f"gearbody {command}: {message}", file=sys.stderr)
     return EXIT_USAGE
+
+
+def check_out(path: Path, option: str = "--out") -> Path:
+    """``path`` if it is a folder this process can write in, or one it can create; else an InputError
+    naming the option, the path and the reason (before any work is done).
+
+    Writability is tried, not read from permission bits (root ignores those): a probe folder is made
+    and removed in ``path`` or in its nearest existing parent. Nothing else is created.
+    """
+    from gearbody.errors import InputError
+
+    path = Path(path)
+    shown = f"{option} {path}"
+    if path.is_symlink() and not path.exists():
+        raise InputError(f"{shown}: a broken symbolic link, not a folder")
+    if path.exists() and not path.is_dir():
+        raise InputError(f"{shown}: is a file, not a folder")
+    base = path
+    while not base.exists() and not base.is_symlink() and base.parent != base:
+        base = base.parent
+    if not base.is_dir():
+        raise InputError(f"{shown}: {base} is a file, not a folder")
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".gearbody-probe-", dir=base))
+    except OSError as exc:
+        where = "in it" if base == path else f"in {base}"
+        raise InputError(f"{shown}: cannot write {where}: {exc.strerror or exc}") from None
+    return path
+
+
+@dataclass(frozen=True)
+class OutOfRange:
+    """An option's value that parsed but lies outside its range (refused by :func:`check_options`)."""
+
+    text: str
+    allowed: str
+
+
+def number(
+    *,
+    whole: bool = False,
+    ge: float | None = None,
+    gt: float | None = None,
+    le: float | None = None,
+) -> Callable[[str], float | OutOfRange]:
+    """An argparse ``type``: the option's text as a finite float (or an int with ``whole``) in the
+    range. Text that is no number is argparse's usage error; a number out of range (NaN and
+    infinities included) is kept as :class:`OutOfRange` and refused by :func:`check_options`, before
+    the command runs, as ``--option = value: must be ...`` (exit 2)."""
+    parts = [f">= {ge:g}" if ge is not None else "", f"> {gt:g}" if gt is not None else ""]
+    parts.append(f"<= {le:g}" if le is not None else "")
+    bounds = " and ".join(p for p in parts if p)
+    what = ("a whole number" if whole else "a finite number") + (f" {bounds}" if bounds else "")
+
+    def convert(text: str) -> float | OutOfRange:
+        try:
+            value = int(text) if whole else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}") from None
+        ok = math.isfinite(value) and (ge is None or value >= ge) and (gt is None or value > gt)
+        return value if ok and (le is None or value <= le) else OutOfRange(text.strip(), what)
+
+    convert.__name__ = "whole number" if whole else "number"  # argparse names the type in messages
+    return convert
+
+
+def check_options(args: argparse.Namespace) -> None:
+    """InputError naming the first option whose value is out of its range (see :func:`number`)."""
+    from gearbody.errors import InputError
+
+    for dest, value in vars(args).items():
+        if isinstance(value, OutOfRange):
+            option = "--" + dest.replace("_", "-")
+            raise InputError(f"{option} = {value.text}: must be {value.allowed}")

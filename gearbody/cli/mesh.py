@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from .common import EXIT_OK, add_out, add_set, default_out, load, usage_error
+from .common import EXIT_OK, add_out, add_set, check_out, default_out, load, number, usage_error
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -26,12 +26,15 @@ def register(sub) -> argparse.ArgumentParser:
     me.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
     add_set(me, "override a scenario value (as for run)")
     me.add_argument(
-        "--stage", type=int, metavar="N", help="only stage N (1 = first in power-flow order; default: all)"
+        "--stage",
+        type=number(whole=True, ge=1),
+        metavar="N",
+        help="only stage N (1 = first in power-flow order; default: all)",
     )
     add_out(me, "output folder (default: runs/SCENE/mesh)")
     me.add_argument(
         "--load",
-        type=float,
+        type=number(ge=0),
         default=1.0,
         metavar="FRACTION",
         help="static TE at this fraction of each stage's rated force (default 1)",
@@ -42,6 +45,7 @@ def register(sub) -> argparse.ArgumentParser:
 
 
 def execute(args) -> int:
+    out = None if args.no_plots else check_out(args.out or default_out(args.scene, "mesh"))
     from gearbody.plotting.mesh import plot_stage
     from gearbody.reports.mesh import damage_windows, static_transmission_error, stiffness_cycle, summary_text
 
@@ -53,7 +57,6 @@ def execute(args) -> int:
         )
     if not (math.isfinite(args.load) and args.load >= 0):
         return usage_error("mesh", f"--load = {args.load!r}: give a fraction >= 0 of the rated force")
-    out = args.out or default_out(args.scene, "mesh")
     stages = range(count) if args.stage is None else [args.stage - 1]
     print(f"{scenario.meta.title}")
     written = []

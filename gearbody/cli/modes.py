@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from .common import EXIT_OK, add_set, load
+from .common import EXIT_OK, add_set, load, number
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -16,7 +16,12 @@ def register(sub) -> argparse.ArgumentParser:
     )
     modes.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
     add_set(modes, "override a scenario value (as for run)")
-    modes.add_argument("--harmonics", type=int, default=3, help="mesh harmonics to list resonance speeds for")
+    modes.add_argument(
+        "--harmonics",
+        type=number(whole=True, ge=1, le=100),
+        default=3,
+        help="mesh harmonics to list resonance speeds for",
+    )
     modes.set_defaults(handler=execute)
     return modes
 

@@ -5,9 +5,21 @@ from __future__ import annotations
 
 import argparse
 import time
+import zipfile
 from pathlib import Path
 
-from .common import EXIT_OK, add_out, add_set, default_out, load, scenario_overrides, usage_error
+from .common import (
+    EXIT_OK,
+    add_out,
+    add_set,
+    check_out,
+    default_out,
+    load,
+    number,
+    scenario_labels,
+    scenario_overrides,
+    usage_error,
+)
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -33,32 +45,46 @@ def register(sub) -> argparse.ArgumentParser:
         "--kinematic", action="store_true", help="no simulation: rigid rotation at synchronous speed"
     )
     add_set(rd, "override a scenario value (as for run)")
-    rd.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time when simulating first")
     rd.add_argument(
-        "--frames", type=int, metavar="N", help="number of frames (default 24; --interactive: 400)"
+        "--t-end", type=number(gt=0), metavar="SECONDS", help="simulated time when simulating first"
+    )
+    rd.add_argument(
+        "--frames",
+        type=number(whole=True, ge=1, le=10000),
+        metavar="N",
+        help="number of frames (default 24; --interactive: 400)",
     )
     rd.add_argument(
         "--start",
-        type=float,
+        type=number(ge=0),
         metavar="SECONDS",
         help="time of the first frame (default: one input-shaft revolution before --end)",
     )
     rd.add_argument(
-        "--end", type=float, metavar="SECONDS", help="time of the last frame (default: end of result)"
+        "--end", type=number(ge=0), metavar="SECONDS", help="time of the last frame (default: end of result)"
     )
     add_out(rd, "output folder (default: runs/SCENE/render)")
     rd.add_argument(
         "--format", choices=("gif", "mp4", "none"), default="gif", help="movie format (default gif)"
     )
-    rd.add_argument("--fps", type=float, default=20.0, help="movie frames per second (default 20)")
+    rd.add_argument(
+        "--fps", type=number(ge=0.1, le=120), default=20.0, help="movie frames per second (default 20)"
+    )
     rd.add_argument("--width", type=int, default=800, help="image width in pixels (default 800)")
     rd.add_argument("--height", type=int, default=600, help="image height in pixels (default 600)")
     rd.add_argument("--view", default="iso", help="camera preset: iso, front, back, side, top (default iso)")
     rd.add_argument(
-        "--azimuth", type=float, metavar="DEG", help="camera azimuth about the vertical, overrides --view"
+        "--azimuth", type=number(), metavar="DEG", help="camera azimuth about the vertical, overrides --view"
     )
-    rd.add_argument("--elevation", type=float, metavar="DEG", help="camera elevation, overrides --view")
-    rd.add_argument("--zoom", type=float, default=1.0, help="magnification (1 = whole drive or all gears)")
+    rd.add_argument(
+        "--elevation", type=number(ge=-90, le=90), metavar="DEG", help="camera elevation, overrides --view"
+    )
+    rd.add_argument(
+        "--zoom",
+        type=number(ge=0.05, le=50),
+        default=1.0,
+        help="magnification (1 = whole drive or all gears)",
+    )
     rd.add_argument(
         "--frame",
         choices=("drive", "gears"),
@@ -73,7 +99,7 @@ def register(sub) -> argparse.ArgumentParser:
     )
     rd.add_argument(
         "--lateral-scale",
-        type=float,
+        type=number(ge=0, le=1e6),
         metavar="X",
         help="magnification of lateral gear motion (default: the scenario's visual.lateral_scale)",
     )
@@ -91,17 +117,19 @@ def register(sub) -> argparse.ArgumentParser:
 
 
 def execute(args) -> int:
-    from gearbody.render import RenderError, RenderOptions, check_frames, render, view
-    from gearbody.result import Result
-
-    overrides = scenario_overrides(args)
-    scenario = load(args.scene, overrides)
     try:
         background = tuple(float(v) for v in args.background.split(","))
-        if len(background) != 3:
+        if len(background) != 3 or not all(0 <= v <= 1 for v in background):
             raise ValueError
     except ValueError:
         return usage_error("render", f"--background = {args.background!r}: give R,G,B in [0, 1]")
+    out_dir = args.out or default_out(args.scene, "render")
+    if not args.interactive:
+        check_out(out_dir)
+    from gearbody.render import RenderError, RenderOptions, check_frames, render, view
+    from gearbody.result import Result
+
+    scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
     options = RenderOptions(
         width_px=args.width,
         height_px=args.height,
@@ -127,7 +155,12 @@ def execute(args) -> int:
                 raise RenderError(
                     f"--result = {args.result}: no result.npz there (write one with 'gearbody run')"
                 )
-            result = Result.load_npz(path)
+            try:
+                result = Result.load_npz(path)
+            except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):  # not gearbody's npz
+                raise RenderError(
+                    f"--result = {args.result}: {path.name} is not a result written by 'gearbody run'"
+                ) from None
         elif args.kinematic:
             result = None
         else:
@@ -136,7 +169,6 @@ def execute(args) -> int:
             if not args.quiet:
                 print(f"simulating {args.scene} ({scenario.operation.t_end_s:g} s) ...")
             result = simulate(scenario, progress=not args.quiet)
-        out_dir = args.out or default_out(args.scene, "render")
         if args.result is None and not args.kinematic and not args.interactive:
             from gearbody.model import dump_scenario
 

@@ -7,7 +7,17 @@ import argparse
 import json
 import time
 
-from .common import EXIT_OK, add_out, add_set, default_out, load, scenario_overrides
+from .common import (
+    EXIT_OK,
+    add_out,
+    add_set,
+    check_out,
+    default_out,
+    load,
+    number,
+    scenario_labels,
+    scenario_overrides,
+)
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -31,7 +41,9 @@ def register(sub) -> argparse.ArgumentParser:
         "override a scenario value by its dotted key, e.g. production.error_mode.e_um=15 "
         '(repeatable; values are TOML: numbers, true/false, [arrays], "strings")',
     )
-    run.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time (sets operation.t_end_s)")
+    run.add_argument(
+        "--t-end", type=number(gt=0), metavar="SECONDS", help="simulated time (sets operation.t_end_s)"
+    )
     add_out(run, "output folder (default: runs/SCENE)")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument(
@@ -45,12 +57,11 @@ def register(sub) -> argparse.ArgumentParser:
 
 
 def execute(args) -> int:
+    out = check_out(args.out or default_out(args.scene))  # before anything is imported or run
     from gearbody.engine import simulate
     from gearbody.model import dump_scenario
 
-    overrides = scenario_overrides(args)
-    scenario = load(args.scene, overrides)
-    out = args.out or default_out(args.scene)
+    scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     result = simulate(scenario, progress=not args.quiet)

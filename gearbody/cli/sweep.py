@@ -5,7 +5,16 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_FAILED, EXIT_OK, add_out, add_set, scenario_overrides, usage_error
+from .common import (
+    EXIT_FAILED,
+    EXIT_OK,
+    add_out,
+    add_set,
+    check_out,
+    number,
+    scenario_overrides,
+    usage_error,
+)
 
 MAX_CASES = 10_000  # gearbody.studies.MAX_CASES (not imported here: heavy imports wait for execute)
 
@@ -48,22 +57,36 @@ def register(sub) -> argparse.ArgumentParser:
         metavar="KEY=DIST",
         help="Monte-Carlo key: KEY=uniform(a,b) | normal(mu,sigma) | choice(v1,v2,...); repeatable",
     )
-    sw.add_argument("--samples", type=int, metavar="N", help="random draws of the --random keys")
     sw.add_argument(
-        "--study-seed", type=int, default=0, metavar="S", help="seed of the random draws (default 0)"
+        "--samples", type=number(whole=True, ge=1), metavar="N", help="random draws of the --random keys"
     )
-    sw.add_argument("--seeds", type=int, metavar="N", help="vary meta.seed (random tooth errors) over 1..N")
     sw.add_argument(
         "--max-cases",
-        type=int,
+        type=number(whole=True, ge=1),
         default=MAX_CASES,
         metavar="N",
         help=f"refuse a study of more than N cases before anything runs (default {MAX_CASES})",
     )
-    add_set(sw, "fixed override of every case (as for run)")
-    sw.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time of every case")
     sw.add_argument(
-        "--workers", type=int, metavar="N", help="local processes (default: all cores; 1: serial)"
+        "--study-seed",
+        type=number(whole=True, ge=0),
+        default=0,
+        metavar="S",
+        help="seed of the random draws (default 0)",
+    )
+    sw.add_argument(
+        "--seeds",
+        type=number(whole=True, ge=1),
+        metavar="N",
+        help="vary meta.seed (random tooth errors) over 1..N",
+    )
+    add_set(sw, "fixed override of every case (as for run)")
+    sw.add_argument("--t-end", type=number(gt=0), metavar="SECONDS", help="simulated time of every case")
+    sw.add_argument(
+        "--workers",
+        type=number(whole=True, ge=1, le=256),
+        metavar="N",
+        help="local processes (default: all cores; 1: serial)",
     )
     sw.add_argument(
         "--scheduler",
@@ -86,6 +109,7 @@ def register(sub) -> argparse.ArgumentParser:
 
 
 def execute(args) -> int:
+    check_out(args.out)
     from gearbody.studies import SweepSpecError, run_study
 
     overrides = scenario_overrides(args)

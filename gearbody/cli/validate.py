@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_FAILED, EXIT_OK
+from .common import EXIT_FAILED, EXIT_OK, load, number
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -14,7 +14,9 @@ def register(sub) -> argparse.ArgumentParser:
     )
     val.add_argument("scenes", metavar="SCENE", nargs="*", help="scenes to validate (default: all)")
     val.add_argument("--short", action="store_true", help="short runs (as in the test suite)")
-    val.add_argument("--tolerance", type=float, default=0.5, help="max |dF|/F_rated in %% (default 0.5)")
+    val.add_argument(
+        "--tolerance", type=number(gt=0), default=0.5, help="max |dF|/F_rated in %% (default 0.5)"
+    )
     val.set_defaults(handler=execute)
     return val
 
@@ -22,5 +24,7 @@ def register(sub) -> argparse.ArgumentParser:
 def execute(args) -> int:
     from gearbody_validation.compare import run_validation
 
+    for scene in args.scenes:  # a misspelled scene fails before the table header
+        load(scene, [])
     ok = run_validation(args.scenes or None, short=args.short, tolerance_percent=args.tolerance)
     return EXIT_OK if ok else EXIT_FAILED

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import copy
+import shlex
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import tomli_w
 
-from .params import ScenarioError, from_dict, to_dict
+from .params import ScenarioError, display_path, from_dict, to_dict
 from .scenario import Scenario
 from .scenes import scene_path
 from .shorthand import canonical_form, legacy_topology, translate_key
@@ -21,76 +23,123 @@ else:  # pragma: no cover
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
-    """Read a TOML file, turning syntax errors into a ScenarioError naming the file."""
+    """Read a TOML file; a missing, unreadable, binary or non-UTF-8 file or a syntax error is a
+    one-line ScenarioError naming the file."""
     path = Path(path)
+    what = "a scenario is a UTF-8 TOML text file"
+    if path.is_dir():
+        raise ScenarioError(f"{path}: is a folder, not a scenario file ({what})")
     try:
-        with path.open("rb") as fh:
-            return tomllib.load(fh)
+        data = path.read_bytes()
     except FileNotFoundError:
         raise ScenarioError(f"{path}: no such scenario file") from None
+    except OSError as exc:
+        raise ScenarioError(f"{path}: cannot read the scenario file: {exc.strerror or exc}") from None
+    if path.suffix == ".npz" or data.startswith(b"PK\x03\x04"):
+        raise ScenarioError(f"{path}: a zip/npz archive (a result?), not a scenario file ({what})")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(
+            f"{path}: not UTF-8 text (byte {data[exc.start]:#04x} at offset {exc.start}); {what}"
+        ) from None
+    if "\x00" in text:
+        raise ScenarioError(f"{path}: a binary file (contains NUL bytes), not a scenario file ({what})")
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
+    except ValueError:  # Python reads integers of at most 4300 digits
+        raise ScenarioError(f"{path}: unreadable value: an integer of more than 4300 digits") from None
 
 
-def parse_override(text: str) -> tuple[str, Any]:
+def override_label(text: str, limit: int = 200) -> str:
+    """``--set KEY=VALUE`` as a user types it in a shell (quoted where the shell needs it; a text of
+    more than ``limit`` characters is shortened)."""
+    if len(text) > limit:
+        text = text[: limit - 3] + "..."
+    return f"--set {shlex.quote(text)}"
+
+
+def parse_override(text: str, label: str | None = None) -> tuple[str, Any]:
     """``'production.error_mode.e_um=15'`` -> ``('production.error_mode.e_um', 15)``.
 
     The value is read as a TOML value (numbers, booleans, arrays, quoted strings); anything that is
-    not valid TOML is taken as a plain string.
+    not valid TOML is taken as a plain string. Errors name ``label`` (default: the ``--set`` as typed).
     """
+    label = label or override_label(text)
     if "=" not in text:
-        raise ScenarioError(f"--set {text!r}: expected KEY=VALUE, e.g. production.error_mode.e_um=15")
+        raise ScenarioError(f"{label}: expected KEY=VALUE, e.g. production.error_mode.e_um=15")
     key, raw = (s.strip() for s in text.split("=", 1))
     if not key:
-        raise ScenarioError(f"--set {text!r}: empty key")
+        raise ScenarioError(f"{label}: empty key")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
+    except ValueError:  # Python reads integers of at most 4300 digits
+        raise ScenarioError(f"{label}: unreadable value: an integer of more than 4300 digits") from None
     return key, value
 
 
 def apply_overrides(
-    data: dict[str, Any], overrides: dict[str, Any] | list[str] | None
-) -> tuple[dict[str, Any], dict[str, str]]:
-    """(copy of the canonical ``data`` with dotted-key overrides set, aliases for messages).
+    data: dict[str, Any],
+    overrides: dict[str, Any] | list[str] | None,
+    labels: Sequence[str] | None = None,
+) -> tuple[dict[str, Any], dict[str, str], dict[str, str]]:
+    """(copy of the canonical ``data`` with dotted-key overrides set, aliases for messages, origins:
+    canonical key -> the override that set it, as typed).
 
     Tables are created as needed; a list item is addressed by its number counted from 1
     (``design.stages.2.mesh.backlash_um``); a single-stage shorthand key (``production.error_mode.e_um``)
     means stage 1 of a one-stage drive and is refused on a longer train, naming the key to write.
+    ``labels`` (one per override) name them in messages; default ``--set KEY=VALUE`` as typed.
     """
     out = copy.deepcopy(data)
     aliases: dict[str, str] = {}
+    origins: dict[str, str] = {}
     if not overrides:
-        return out, aliases
-    items = [parse_override(o) for o in overrides] if isinstance(overrides, list) else overrides.items()
-    for key, value in items:
+        return out, aliases, origins
+    if isinstance(overrides, list):
+        labels = list(labels) if labels is not None else [override_label(o) for o in overrides]
+        items = [(lab, *parse_override(o, lab)) for o, lab in zip(overrides, labels, strict=True)]
+    else:
+        items = [(f"override {k}={v!r}", k, v) for k, v in overrides.items()]
+    for label, key, value in items:
         if key == "meta.scene":  # the older name of meta.topology
-            key, value = "meta.topology", legacy_topology(value, "--set")
+            key, value = "meta.topology", legacy_topology(value, label)
         try:
             parts, alias = translate_key(key.split("."), out)
         except ScenarioError as exc:
-            raise ScenarioError(f"--set {exc}") from None
+            raise ScenarioError(f"{label}: {exc}") from None
         aliases.update(alias)
-        _set_key(out, parts, value, key)
-    return out, aliases
+        _set_key(out, parts, value, label, alias)
+        origins[".".join(parts)] = label
+    return out, aliases, origins
 
 
-def _set_key(data: dict[str, Any], parts: list[str], value: Any, key: str) -> None:
+def _set_key(data: dict[str, Any], parts: list[str], value: Any, label: str, aliases: dict[str, str]) -> None:
     node: Any = data
+
+    def key(depth: int) -> str:  # the first ``depth`` parts, as the user typed them
+        return display_path(".".join(parts[:depth]), aliases)
+
     for depth, part in enumerate(parts):
         last = depth == len(parts) - 1
-        where = ".".join(parts[: depth + 1])
         if isinstance(node, list):
-            if not part.isdigit():
+            if not node:
                 raise ScenarioError(
-                    f"--set {key}: {'.'.join(parts[:depth])} is a list; address an item by its number, "
-                    f"1..{len(node)} (e.g. {'.'.join(parts[:depth])}.1)"
+                    f"{label}: {key(depth)} is an empty list; give the whole list, e.g. {key(depth)}=[...]"
+                )
+            if not (part.isascii() and part.isdigit()):
+                raise ScenarioError(
+                    f"{label}: {key(depth)} is a list; address an item by its number, "
+                    f"1..{len(node)} (e.g. {key(depth)}.1)"
                 )
             index = int(part)
             if not 1 <= index <= len(node):
                 raise ScenarioError(
-                    f"--set {key}: {where}: no item {index}; {'.'.join(parts[:depth])} has {len(node)} "
+                    f"{label}: {key(depth + 1)}: no item {index}; {key(depth)} has {len(node)} "
                     f"(valid: 1..{len(node)})"
                 )
             if last:
@@ -101,18 +150,27 @@ def _set_key(data: dict[str, Any], parts: list[str], value: Any, key: str) -> No
             if last:
                 node[part] = value
                 return
+            nxt = parts[depth + 1]
+            if part not in node and nxt.isascii() and nxt.isdigit():
+                raise ScenarioError(
+                    f"{label}: {key(depth + 1)} has no item {nxt} (it is not given); give the whole "
+                    f"list, e.g. {key(depth + 1)}=[...]"
+                )
             node = node.setdefault(part, {})
         else:
-            raise ScenarioError(f"--set {key}: {'.'.join(parts[:depth])!r} is a value, not a table")
+            raise ScenarioError(f"{label}: {key(depth)!r} is a value, not a table")
         if not isinstance(node, (dict, list)):
-            raise ScenarioError(f"--set {key}: {where!r} is a value, not a table")
+            raise ScenarioError(f"{label}: {key(depth + 1)!r} is a value, not a table")
 
 
 def load_scenario(
-    source: str | Path | dict[str, Any], overrides: dict[str, Any] | list[str] | None = None
+    source: str | Path | dict[str, Any],
+    overrides: dict[str, Any] | list[str] | None = None,
+    labels: Sequence[str] | None = None,
 ) -> Scenario:
     """Build a validated :class:`Scenario` from a TOML path, a scene name, or a nested dict (either the
-    canonical shape or the single-stage shorthand), with optional ``KEY=VALUE`` overrides."""
+    canonical shape or the single-stage shorthand), with optional ``KEY=VALUE`` overrides; errors
+    caused by an override quote it as typed (``labels``: one per override, default ``--set KEY=VALUE``)."""
     if isinstance(source, dict):
         data, name, stem = source, "<dict>", ""
     else:
@@ -121,11 +179,11 @@ def load_scenario(
             path = scene_path(str(source))
         data, name, stem = read_toml(path), str(path), path.stem
     data, aliases = canonical_form(data, name)
-    data, more = apply_overrides(data, overrides)
+    data, more, origins = apply_overrides(data, overrides, labels)
     meta = data.setdefault("meta", {})
     if isinstance(meta, dict) and not meta.get("name") and stem:
         meta["name"] = stem
-    return from_dict(Scenario, data, source=name, aliases={**aliases, **more})
+    return from_dict(Scenario, data, source=name, aliases={**aliases, **more}, origins=origins)
 
 
 def scenario_to_dict(scenario: Scenario) -> dict[str, Any]:

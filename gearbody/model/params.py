@@ -100,21 +100,70 @@ class _Ctx:
 
     ``aliases`` maps canonical key prefixes to the keys the user wrote (the single-stage shorthand:
     ``design.stages.1.pinion`` was written ``design.pinion``), so that messages name the user's key.
+    ``origins`` maps the canonical keys set by overrides to the override as typed
+    (``--set production.error_mode.e_um=abc``), so that messages blame the override, not the file.
     """
 
-    def __init__(self, source: str, path: str = "", aliases: typing.Mapping[str, str] | None = None):
-        self.source, self.path, self.aliases = source, path, dict(aliases or {})
+    def __init__(
+        self,
+        source: str,
+        path: str = "",
+        aliases: typing.Mapping[str, str] | None = None,
+        origins: typing.Mapping[str, str] | None = None,
+    ):
+        self.source, self.path = source, path
+        self.aliases, self.origins = dict(aliases or {}), dict(origins or {})
 
     def child(self, key: str) -> _Ctx:
-        return _Ctx(self.source, f"{self.path}.{key}" if self.path else key, self.aliases)
+        return _Ctx(self.source, f"{self.path}.{key}" if self.path else key, self.aliases, self.origins)
 
     def shown(self, path: str | None = None) -> str:
         """``path`` (default: this one) as the user wrote it."""
         return display_path(self.path if path is None else path, self.aliases)
 
+    def where(self, path: str | None = None) -> str:
+        """The source of the value at ``path`` (default: this one): the override that set it or a key
+        above or below it, else the file."""
+        path = self.path if path is None else path
+        hits = [k for k in self.origins if _related(k, path)] if path else []
+        return self._blame(hits)
+
+    def _blame(self, hits: list[str]) -> str:
+        if not hits:
+            return self.source
+        on = "" if self.source == "<dict>" else f" (on {self.source})"
+        return f"{self.origins[max(hits, key=len)]}{on}"
+
+    def where_text(self, text: str) -> str:
+        """The source of a cross-check message naming canonical keys in ``text``: the override of the
+        longest such key, else the file with every override applied to it."""
+        keys = re.findall(r"[A-Za-z_]\w*(?:\.\w+)+", text)
+        hits = [k for k in self.origins if any(_related(k, t) for t in keys)]
+        if hits:
+            return self._blame(hits)
+        if self.origins:
+            return f"{self.source} with {', '.join(dict.fromkeys(self.origins.values()))}"
+        return self.source
+
     def fail(self, value: Any, message: str) -> typing.NoReturn:
-        shown = f"{value:.6g}" if isinstance(value, float) else repr(value)
-        raise ScenarioError(f"{self.source}: {self.shown()} = {shown}: {message}")
+        shown = f"{value:.6g}" if isinstance(value, float) else _short_repr(value)
+        raise ScenarioError(f"{self.where()}: {self.shown()} = {shown}: {message}")
+
+
+def _related(key: str, path: str) -> bool:
+    """True when dotted ``key`` is ``path``, above it or below it."""
+    return key == path or path.startswith(key + ".") or key.startswith(path + ".")
+
+
+def _short_repr(value: Any, limit: int = 120) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else f"{text[: limit - 3]}..."
+
+
+def _range_note(meta: typing.Mapping[str, Any]) -> str:
+    """`` (range)`` of a field with a range, nothing for one without."""
+    text = describe_range(meta)
+    return "" if text == "any value" else f" ({text})"
 
 
 def display_path(path: str, aliases: typing.Mapping[str, str]) -> str:
@@ -166,11 +215,14 @@ def _convert(value: Any, tp: Any, ctx: _Ctx, meta: typing.Mapping[str, Any]) -> 
         return value
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
-            ctx.fail(value, f"must be a whole number ({describe_range(meta)})")
+            ctx.fail(value, f"must be a whole number{_range_note(meta)}")
     elif tp is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            ctx.fail(value, f"must be a number ({describe_range(meta)})")
-        value = float(value)
+            ctx.fail(value, f"must be a number{_range_note(meta)}")
+        try:
+            value = float(value)
+        except OverflowError:  # an int of hundreds of digits
+            ctx.fail(value, f"too large for a floating-point number{_range_note(meta)}")
         if not math.isfinite(value):
             ctx.fail(value, "must be finite")
     elif tp is str:
@@ -196,7 +248,7 @@ def _from_dict(cls: type, data: typing.Mapping[str, Any], ctx: _Ctx) -> Any:
                 if near
                 else f"; valid keys here: {', '.join(fields)}"
             )
-            raise ScenarioError(f"{ctx.source}: unknown key {ctx.child(key).shown()!r}{hint}")
+            raise ScenarioError(f"{ctx.child(key).where()}: unknown key {ctx.child(key).shown()!r}{hint}")
     kwargs = {}
     for name, f in fields.items():
         sub = ctx.child(name)
@@ -213,8 +265,22 @@ def _from_dict(cls: type, data: typing.Mapping[str, Any], ctx: _Ctx) -> Any:
         prepare = getattr(cls, "prepare_fields", None)  # e.g. Scenario: resolve gear geometry first
         return cls(**(prepare(kwargs) if prepare else kwargs))
     except ScenarioError as exc:
-        where = f"[{ctx.shown()}] " if ctx.path else ""
-        raise ScenarioError(f"{ctx.source}: {where}{display_text(str(exc), ctx.aliases)}") from None
+        text = str(exc)
+        if not ctx.path:
+            raise ScenarioError(f"{ctx.where_text(text)}: {display_text(text, ctx.aliases)}") from None
+        raise ScenarioError(f"{ctx.where()}: {_under(ctx.shown(), text, fields)}") from None
+
+
+def _under(shown: str, text: str, fields: typing.Mapping[str, Any]) -> str:
+    """A node's own check message as the user's dotted key: ``spall_end_diameter_mm = 0: ...`` of
+    ``condition.damaged_teeth.1`` -> ``condition.damaged_teeth.1.spall_end_diameter_mm = 0: ...``."""
+    last = shown.rsplit(".", 1)[-1]
+    if text.startswith(last + "."):  # 'bearing.kind = ...' said by the bearing itself
+        text = text[len(last) + 1 :]
+    head = re.match(r"[A-Za-z_]\w*", text)
+    if head and head.group(0) in fields:
+        return f"{shown}.{text}"
+    return f"{shown}: {text}"
 
 
 def from_dict(
@@ -222,12 +288,14 @@ def from_dict(
     data: typing.Mapping[str, Any],
     source: str = "<scenario>",
     aliases: typing.Mapping[str, str] | None = None,
+    origins: typing.Mapping[str, str] | None = None,
 ) -> Any:
     """Build dataclass ``cls`` from a nested dict, checking keys, types and ranges; ``aliases`` name
-    canonical keys as the user wrote them in messages (see :class:`_Ctx`)."""
+    canonical keys as the user wrote them and ``origins`` the overrides that set keys, in messages
+    (see :class:`_Ctx`)."""
     if not isinstance(data, dict):
         raise ScenarioError(f"{source}: the scenario must be a table of sections, got {type(data).__name__}")
-    return _from_dict(cls, data, _Ctx(source, aliases=aliases))
+    return _from_dict(cls, data, _Ctx(source, aliases=aliases, origins=origins))
 
 
 def to_dict(obj: Any) -> Any:

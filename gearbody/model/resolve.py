@@ -123,10 +123,16 @@ def resolve_stage_geometry(pinion, wheel, mesh, where: str):
     if mesh.stiffness_profile == "potential-energy":
         from ..physics.mesh_stiffness import pair_stiffness_table
 
+        _check_bores(mesh, pinion.teeth, wheel.teeth, where)
         try:
             table = pair_stiffness_table(g, pinion.teeth, wheel.teeth)
         except ValueError as exc:
             raise ScenarioError(f"{where}{exc}") from None
+        except ArithmeticError:
+            raise ScenarioError(
+                f"{where}geometry: the potential-energy stiffness overflows for this geometry; check "
+                "its bore diameters, module and face width"
+            ) from None
         single, double = table.zone_means_N_per_m()
         derived["stiffness_single_N_per_m"] = _agree(
             where, "stiffness_single_N_per_m", mesh.stiffness_single_N_per_m, single
@@ -139,6 +145,22 @@ def resolve_stage_geometry(pinion, wheel, mesh, where: str):
             if getattr(mesh, key) is None:
                 derived[key] = MESH_DEFAULTS[key]
     return out_gears[0], out_gears[1], dataclasses.replace(mesh, **derived)
+
+
+def _check_bores(mesh, teeth_pinion: int, teeth_wheel: int, where: str) -> None:
+    """A bore lies inside its gear's root circle (the rim under the teeth has a thickness)."""
+    from ..physics.mesh_stiffness import spur_pair
+
+    try:
+        pair = spur_pair(mesh.geometry, teeth_pinion, teeth_wheel)
+    except ValueError as exc:
+        raise ScenarioError(f"{where}{exc}") from None
+    for name, gear in (("pinion", pair.pinion), ("wheel", pair.wheel)):
+        if not gear.bore_radius_m < gear.root_radius_m:
+            raise ScenarioError(
+                f"{where}geometry.bore_diameter_{name}_mm = {2e3 * gear.bore_radius_m:g}: must be < the "
+                f"{name}'s root diameter {2e3 * gear.root_radius_m:.4g} mm"
+            )
 
 
 def resolve_iso_stiffness(mesh, teeth_pinion: int, teeth_wheel: int, rated_force_N: float, where: str):
@@ -196,4 +218,9 @@ def resolve_design(design):
                 stage_pair_table(st)
             except ValueError as exc:
                 raise ScenarioError(f"{stage_key(k, 'damaged_teeth')}: {exc}") from None
+            except ArithmeticError:
+                raise ScenarioError(
+                    f"{stage_key(k, 'damaged_teeth')}: the damaged teeth's potential-energy stiffness "
+                    "overflows; check their damage sizes and the mesh's geometry"
+                ) from None
     return dataclasses.replace(design, stages=tuple(stages))

@@ -290,25 +290,32 @@ def _check_stage(k: int, stage: Stage) -> None:
             f"{stage.pinion.base_radius_m * stage.wheel.teeth / stage.pinion.teeth:.6g} m)"
         )
     for key, entries in (("damaged_teeth", stage.damaged_teeth), ("pitted_teeth", stage.pitted_teeth)):
-        for t in entries:
+        seen: dict[tuple[str, int], int] = {}
+        for i, t in enumerate(entries, start=1):
             z = getattr(stage, t.gear).teeth
             if t.tooth >= z:
                 raise ScenarioError(
-                    f"{stage_key(k, key)}: tooth = {t.tooth} on the {t.gear}: must be < its {z} teeth"
+                    f"{stage_key(k, key)}.{i}.tooth = {t.tooth} on the {t.gear}: must be < its {z} teeth "
+                    f"(0..{z - 1})"
                 )
-        teeth = [(t.gear, t.tooth) for t in entries]
-        if key == "pitted_teeth" and len(set(teeth)) < len(teeth):
-            raise ScenarioError(f"{stage_key(k, key)}: one pit per tooth, got {teeth}")
-    for t in stage.pitted_teeth:
+            if (t.gear, t.tooth) in seen:
+                what = "one pit per tooth" if key == "pitted_teeth" else "one entry per damaged tooth"
+                raise ScenarioError(
+                    f"{stage_key(k, key)}.{i}: {what}: {t.gear} tooth {t.tooth} is also entry "
+                    f"{seen[t.gear, t.tooth]}"
+                    + ("; give its damage in one entry" if key == "damaged_teeth" else "")
+                )
+            seen[t.gear, t.tooth] = i
+    for i, t in enumerate(stage.pitted_teeth, start=1):
         if not t.end_phase > t.start_phase:
             raise ScenarioError(
-                f"{stage_key(k, 'pitted_teeth')}: end_phase = {t.end_phase} must be > start_phase = "
+                f"{stage_key(k, 'pitted_teeth')}.{i}.end_phase = {t.end_phase} must be > start_phase = "
                 f"{t.start_phase} (a pit spans [start_phase, end_phase) of the mesh period)"
             )
         w = stage.mesh.transition_width
         if t.end_phase - t.start_phase < w:
             raise ScenarioError(
-                f"{stage_key(k, 'pitted_teeth')}: the pit on {t.gear} tooth {t.tooth} spans "
+                f"{stage_key(k, 'pitted_teeth')}.{i}: the pit on {t.gear} tooth {t.tooth} spans "
                 f"{t.end_phase - t.start_phase:g} of the mesh period, less than the mesh's "
                 f"transition_width = {w:g}; narrow the width or widen the pit"
             )

@@ -167,13 +167,19 @@ def translate_key(path: list[str], data: dict[str, Any]) -> tuple[list[str], dic
     """A dotted override key on a canonical dict: a shorthand key becomes its stage-1 (or shaft) key
     when the drive has one stage; (new path, alias for messages). Refused on longer trains."""
     if len(path) >= 2 and path[0] in CANONICAL_KEYS:
-        _refuse_unknown({t: ({path[1]: None} if t == path[0] else None) for t in CANONICAL_KEYS}, "--set")
+        tables = {t: ({path[1]: None} if t == path[0] else None) for t in CANONICAL_KEYS}
+        _refuse_unknown(tables, ".".join(path))
     if len(path) < 2 or (path[0], path[1]) not in (*STAGE_KEYS, *SHAFT_KEYS):
         return path, {}
     key = (path[0], path[1])
-    stages = data.get("design", {}).get("stages") or []
+    design, meta = data.get("design", {}), data.get("meta")
+    if not isinstance(design, dict):
+        raise ScenarioError(f"{'.'.join(path)}: design = {design!r}: must be a table")
+    stages = design.get("stages") or []
+    if not isinstance(stages, list):
+        raise ScenarioError(f"{'.'.join(path)}: design.stages = {stages!r}: must be a list of stages")
     n = len(stages)
-    topology = data.get("meta", {}).get("topology")
+    topology = meta.get("topology") if isinstance(meta, dict) else None
     dotted = ".".join(path)
     if key in SHAFT_KEYS and topology != "train":
         raise ScenarioError(

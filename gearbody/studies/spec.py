@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from gearbody.model import Scenario, ScenarioError, parse_override
-from gearbody.model.io import load_scenario, read_toml
+from gearbody.model.io import load_scenario, override_label, read_toml
 
 from .parse import (
     MAX_CASES,
@@ -52,8 +52,8 @@ def _resolve_scene(scene: str | Path) -> tuple[str, Path]:
     path = Path(scene)
     if not path.suffix and not path.exists():
         return str(scene), scene_path(str(scene))
-    if not path.is_file():
-        raise ScenarioError(f"{path}: no such scenario file")
+    if not path.exists():
+        raise ScenarioError(f"{path}: no such scenario file")  # a folder or binary: read_toml says so
     return str(path.resolve()), path
 
 
@@ -200,22 +200,30 @@ class Study:
         }
 
     def load_case(self, case: Case) -> Scenario:
-        """The case's validated scenario; a ScenarioError names the case and the argument at fault (the
-        first whose override alone, on top of the fixed ones, is refused)."""
+        """The case's validated scenario; a ScenarioError names the case and the argument at fault as
+        typed (``--set ...``, ``--vary ...``, ``--random ...``; else the first whose override alone, on
+        top of the fixed ones, is refused)."""
+        labels = {a.key: a.label for a in self.axes()}
+        typed = [override_label(o) for o in self.base_overrides]
+        typed += [labels[key] or override_label(f"{key}={t}") for key, t in case.texts.items()]
         try:
-            return load_scenario(self.base, list(case.overrides))
+            return load_scenario(self.base, list(case.overrides), typed)
         except ScenarioError as exc:
+            values = ", ".join(f"{k}={t}" for k, t in case.texts.items())
+            text = str(exc)
+            blamed = next((lab for lab in typed if text.startswith(lab)), None)
+            if blamed is not None:  # the message starts with the argument as typed
+                rest = text[len(blamed) :].lstrip(": ")
+                raise ScenarioError(f"{blamed}: {case.id} ({values}): {rest}") from None
             fixed = list(self.base_overrides)
             where = ""
             if not _loads(self.base, fixed):
                 where = "--set: "
             else:
-                labels = {a.key: a.label for a in self.axes()}
-                for key, text in case.texts.items():
-                    if not _loads(self.base, [*fixed, f"{key}={text}"]):
+                for key, t in case.texts.items():
+                    if not _loads(self.base, [*fixed, f"{key}={t}"]):
                         where = f"{labels[key]}: "
                         break
-            values = ", ".join(f"{k}={t}" for k, t in case.texts.items())
             raise ScenarioError(f"{where}{case.id} ({values}): {exc}") from None
 
 
