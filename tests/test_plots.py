@@ -67,3 +67,73 @@ def test_plot_spectrum_defaults_and_named_shafts(tmp_path, signals):
 def test_harmonic_labels():
     assert harmonic_labels(3) == ["f_z", "2f_z", "3f_z"]
     assert harmonic_labels(2, "f_{z1}") == ["f_{z1}", "2f_{z1}"]
+
+
+def _text_boxes(fig):
+    """Window extents of every text drawn in ``fig`` (tick labels only where their tick is in view)."""
+    from matplotlib.text import Text
+
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    ticks = set()
+    for ax in fig.axes:
+        for axis, (low, high) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                inside = min(low, high) <= tick.get_loc() <= max(low, high)
+                ticks.update({id(tick.label1), id(tick.label2)} if not inside else set())
+    texts = [
+        t
+        for t in fig.findobj(Text)
+        if t.get_visible() and t.get_text().strip() and id(t) not in ticks and t.get_alpha() != 0
+    ]
+    return [(t.get_text(), t.get_window_extent(renderer)) for t in texts]
+
+
+def _assert_no_overlap_inside(fig):
+    boxes = _text_boxes(fig)
+    frame = fig.bbox
+    for text, box in boxes:
+        assert box.x0 >= frame.x0 - 0.5 and box.x1 <= frame.x1 + 0.5, f"{text!r} leaves the figure"
+        assert box.y0 >= frame.y0 - 0.5 and box.y1 <= frame.y1 + 0.5, f"{text!r} leaves the figure"
+    for i, (a, box_a) in enumerate(boxes):
+        for b, box_b in boxes[i + 1 :]:
+            assert not box_a.overlaps(box_b), f"{a!r} overlaps {b!r}"
+    return boxes
+
+
+def test_spectrum_labels_neither_overlap_nor_leave_the_figure():
+    """The run's spectrum.png: f_1, f_2 lie 11 Hz apart at the left edge, the 8th harmonic sits on the
+    right edge, and the title is longer than the axes (issue 17)."""
+    from gearbody.plotting.result import spectrum_figure
+
+    fs_hz, f_mesh = 8000.0, 493.8
+    t = np.arange(4000) / fs_hz
+    x = sum(np.sin(2 * np.pi * k * f_mesh * t) / k for k in range(1, 9))
+    title = "Lateral gear train with 8 degrees of freedom, bearings and housing, run-up of Fig. 12: " * 2
+    fig = spectrum_figure(
+        amplitude_spectrum(x, fs_hz),
+        mesh_frequency_hz=f_mesh,
+        shaft_frequencies_hz={"f_1": f_mesh / 29, "f_2": f_mesh / 88},
+        title=title,
+        fmax_hz=8 * f_mesh,
+        log_amplitude=True,
+    )
+    texts = [text for text, _ in _assert_no_overlap_inside(fig)]
+    assert "$8f_z$" in texts and any("f_1" in s for s in texts) and any("f_2" in s for s in texts)
+
+
+def test_labelled_spectrum_labels_do_not_overlap():
+    """report.html's spectrum: peaks 17 Hz apart near 1000-1200 Hz keep only labels that do not overlap."""
+    from gearbody.analysis import LabelledPeak
+    from gearbody.plotting.spectrum import plot_labelled_spectrum
+
+    fs_hz = 8000.0
+    t = np.arange(8000) / fs_hz
+    spec = amplitude_spectrum(np.sin(2 * np.pi * 1000 * t), fs_hz)
+    peaks = [
+        LabelledPeak(1000 + 17 * i, 1.0 / (1 + i), 30.0, (f"2 f_z1 + {i} f_pinion",) if i % 3 else (), 0.0)
+        for i in range(15)
+    ]
+    ax = plot_labelled_spectrum(spec, peaks, title="spectrum " * 30, unit="m/s^2", f_max_hz=3000)
+    texts = [text for text, _ in _assert_no_overlap_inside(ax.figure)]
+    assert "2 f_z1 + 1 f_pinion" in texts  # the strongest explained peak keeps its label

@@ -62,3 +62,40 @@ def test_kd_peaks_at_the_mesh_mode(tmp_path):
     assert plot_campbell(modes, 29, 200, tmp_path / "c.png", operating_speed_rad_s=107).stat().st_size > 1000
     with pytest.raises(ValueError, match="speed_fractions"):
         kd_speed_sweep(sc, [0.0])
+
+
+def test_every_peaks_column_has_a_unit(steady_run, tmp_path):
+    import re
+
+    text = write_report(steady_run, tmp_path / "report.html").read_text()
+    table = text[text.index("<h2>Labelled spectrum") :]
+    headers = re.findall(r"<th>(.*?)</th>", table[: table.index("</tr>")])
+    assert len(headers) == 5 and "kinematic line" in headers
+    for header in headers:
+        assert header == "kinematic line" or re.search(r"\[[^\]]+\]$", header), header
+    assert "amplitude [rad/s^2]" in headers  # two-wheel's vibration signal is the pinion acceleration
+
+
+def test_the_strongest_kinematic_lines_are_named():
+    """One-stage-like spectrum: a pinion-runout sideband f_z1 + 4 f_pinion stronger than 12x pinion must
+    be named like it (issue 17: it was unnamed while weaker lines were named)."""
+    from gearbody.analysis import amplitude_spectrum, label_peaks
+    from gearbody.reports.html import spectrum_lines
+
+    fs_hz, f_pinion, z1, z2 = 8000.0, 17.03, 29, 88
+    f_z = z1 * f_pinion
+    t = np.arange(int(2 * fs_hz)) / fs_hz
+    tones = {f_z: 400.0, 2 * f_z: 70.0, f_z + 4 * f_pinion: 20.0, 2 * f_z - 9 * f_pinion: 15.0}
+    tones[12 * f_pinion] = 5.0
+    rng = np.random.default_rng(0)
+    x = sum(a * np.sin(2 * np.pi * f * t) for f, a in tones.items()) + 0.01 * rng.standard_normal(t.size)
+    spec = amplitude_spectrum(x, fs_hz, window="hann")
+    f_max = 6 * f_z
+    peaks = label_peaks(
+        spec, spectrum_lines(f_pinion, [(z1, z2)], f_max), tolerance_hz=1.5 * spec.resolution_hz,
+        min_prominence_db=12.0, max_peaks=40, f_max_hz=f_max,
+    )
+    strongest = sorted(peaks, key=lambda p: -p.amplitude)[: len(tones)]
+    assert all(p.explained for p in strongest), [(p.frequency_hz, p.label) for p in strongest]
+    labels = " | ".join(p.label for p in strongest)
+    assert "f_z1 + 4 f_pinion" in labels and "2 f_z1 - 9 f_pinion" in labels and "12x pinion" in labels

@@ -8,7 +8,7 @@ of labelled frequencies, :class:`KinematicLine`. Engine-free.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -167,7 +167,7 @@ def kinematic_lines(
     sources: KinematicSources,
     f_max_hz: float,
     harmonics: int = 3,
-    sidebands: int = 2,
+    sidebands: int | Mapping[str, int] = 2,
     shaft_orders: int = 3,
 ) -> list[KinematicLine]:
     """Catalogue of kinematic lines in (0, f_max_hz], sorted by frequency.
@@ -175,7 +175,10 @@ def kinematic_lines(
     - "shaft": m f_shaft, m = 1 .. shaft_orders, labelled "1x pinion", "2x wheel", ...
     - "mesh": k f_z, k = 1 .. harmonics, labelled "1 f_z1", "2 f_z1", ...
     - "sideband": k f_z +- n f_shaft for both shafts of the mesh, n = 1 .. sidebands, labelled
-      "f_z1 + 2 f_pinion", "2 f_z1 - f_wheel", ...
+      "f_z1 + 2 f_pinion", "2 f_z1 - f_wheel", ... ``sidebands`` may map shaft names to their own
+      count (e.g. {"pinion": 14, "wheel": 3}: a pinion runout modulates the mesh far out, while a slow
+      wheel's closely spaced orders would otherwise explain nearly any peak); shafts it omits get 0,
+      cross lines the least count.
     - "cross": for every pair of meshes, k f_c +- n f_m with f_c the higher and f_m the lower mesh
       frequency, k = 1 .. harmonics, n = 1 .. sidebands, labelled "f_z1 - f_z2", ... A combination that
       comes out negative shows at its absolute value and is labelled accordingly ("2 f_z2 - f_z1").
@@ -186,7 +189,16 @@ def kinematic_lines(
         raise ValueError(f"sources must be a KinematicSources, got {type(sources).__name__}")
     f_max_hz = positive_frequency("f_max_hz", f_max_hz)
     harmonics = integer_at_least("harmonics", harmonics, 1)
-    sidebands = integer_at_least("sidebands", sidebands, 0)
+    if isinstance(sidebands, Mapping):
+        names = [s.name for s in sources.shafts]
+        for name in sidebands:
+            if name not in names:
+                raise ValueError(f"sidebands names shaft {name!r}, not one of the shafts {names}")
+        sideband_count = {n: integer_at_least(f"sidebands[{n!r}]", k, 0) for n, k in sidebands.items()}
+        cross_sidebands = min(sideband_count.values(), default=0)
+    else:
+        cross_sidebands = integer_at_least("sidebands", sidebands, 0)
+        sideband_count = {s.name: cross_sidebands for s in sources.shafts}
     shaft_orders = integer_at_least("shaft_orders", shaft_orders, 0)
     frequency = {s.symbol: s.rotation_hz for s in sources.shafts}
     frequency.update({m.name: m.mesh_hz for m in sources.meshes})
@@ -209,14 +221,14 @@ def kinematic_lines(
             add("mesh", ((mesh.name, k),), f"{k} {mesh.name}")
             for shaft_name in mesh.shafts:
                 symbol = sources.shaft(shaft_name).symbol
-                for n in range(1, sidebands + 1):
+                for n in range(1, sideband_count.get(shaft_name, 0) + 1):
                     for sign in (1, -1):
                         add("sideband", ((mesh.name, k), (symbol, sign * n)))
     for i, first in enumerate(sources.meshes):
         for second in sources.meshes[i + 1 :]:
             carrier, modulation = (first, second) if first.mesh_hz >= second.mesh_hz else (second, first)
             for k in range(1, harmonics + 1):
-                for n in range(1, sidebands + 1):
+                for n in range(1, cross_sidebands + 1):
                     for sign in (1, -1):
                         add("cross", ((carrier.name, k), (modulation.name, sign * n)))
     lines.sort(key=lambda line: line.frequency_hz)

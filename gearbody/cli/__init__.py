@@ -19,13 +19,13 @@ __all__ = ["main"]
 EPILOG = """examples:
   gearbody list
   gearbody run one-stage --out runs/one-stage
-  gearbody run one-stage --set production.error_mode.e_um=15 --set design.coupling.damping_Nms_per_rad=1000
+  gearbody run one-stage --set production.error_mode.e_um=15 --out runs/one-stage-e15
   gearbody run my-drive.toml --t-end 1.0 --out runs/mine
   gearbody modes one-stage
   gearbody mesh one-stage-geometry --set 'condition.damaged_teeth=[{gear="pinion",tooth=0,crack_depth_mm=2}]'
   gearbody validate one-stage
   gearbody render industrial-two-stage --frames 100 --out runs/pictures
-  gearbody render one-stage --result runs/one-stage --view front --frame gears --zoom 3
+  gearbody render one-stage --result runs/one-stage --view front --frame gears
 """
 
 COMMANDS = (listing, run, modes, mesh, validate, sweep, sensitivity, render)

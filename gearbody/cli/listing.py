@@ -9,7 +9,13 @@ from .common import EXIT_OK
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
-    parser = sub.add_parser("list", help="list the shipped scenes, one per line (name first, then its title)")
+    about = "list the shipped scenes, one per line (name first, then its title)"
+    parser = sub.add_parser(
+        "list",
+        help=about,
+        description=f"{about[0].upper()}{about[1:]}. A name is what run, modes, mesh, sweep and render take"
+        " as SCENE; a .toml path works as well.",
+    )
     parser.set_defaults(handler=execute)
     return parser
 

@@ -11,8 +11,12 @@ from .common import EXIT_OK, add_set, load, number
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    about = "natural frequencies (Hz) at mean mesh stiffness, and resonance speeds"
     modes = sub.add_parser(
-        "modes", help="natural frequencies (Hz) at mean mesh stiffness, and resonance speeds"
+        "modes",
+        help=about,
+        description=f"{about[0].upper()}{about[1:]}: the linearised model's modes with their dominant"
+        " motion, and the pinion speeds at which the first mesh harmonics meet them.",
     )
     modes.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
     add_set(modes, "override a scenario value (as for run)")
@@ -20,7 +24,7 @@ def register(sub) -> argparse.ArgumentParser:
         "--harmonics",
         type=number(whole=True, ge=1, le=100),
         default=3,
-        help="mesh harmonics to list resonance speeds for",
+        help="mesh harmonics to list resonance speeds for (default 3)",
     )
     modes.set_defaults(handler=execute)
     return modes
@@ -38,8 +42,10 @@ def execute(args) -> int:
     print(f"linearised at mean mesh stiffness {k} N/m; DOFs: {', '.join(modes.dof_names)}")
     speeds = resonance_speeds_rad_s(modes, z1, args.harmonics)
     head = "".join(f"{f'w({h}f_z) rad/s':>18}" for h in range(1, args.harmonics + 1))
-    width = max(len(modes.label(m)) for m in range(len(modes.frequencies_hz))) + 2
-    print(f"{'mode':>4} {'f_n Hz':>12}  {'dominant motion (share of kinetic energy)':<{width}}{head}")
+    motion = "dominant motion (share of kinetic energy)"
+    # the column is as wide as its longest entry, header included, so that the values stay under theirs
+    width = max(len(motion), *(len(modes.label(m)) for m in range(len(modes.frequencies_hz)))) + 2
+    print(f"{'mode':>4} {'f_n Hz':>12}  {motion:<{width}}{head}")
     for m, f in enumerate(modes.frequencies_hz):
         cols = "".join(f"{'-' if math.isnan(s) else f'{s:.2f}':>18}" for s in speeds[:, m])
         print(f"{m + 1:>4} {f:12.3f}  {modes.label(m):<{width}}{cols}")

@@ -83,13 +83,13 @@ def register(sub) -> argparse.ArgumentParser:
         "--zoom",
         type=number(ge=0.05, le=50),
         default=1.0,
-        help="magnification (1 = whole drive or all gears)",
+        help="magnification (default 1 = whole drive or all gears)",
     )
     rd.add_argument(
         "--frame",
         choices=("drive", "gears"),
         default="drive",
-        help="what the camera fits: the whole drive or the gears (hides motor and machine)",
+        help="what the camera fits: the whole drive (default) or the gears (hides motor and machine)",
     )
     rd.add_argument(
         "--housing",
@@ -109,7 +109,9 @@ def register(sub) -> argparse.ArgumentParser:
         help="magnify the whole lateral displacement, static deflection included "
         "(default: the motion about its mean over the frames)",
     )
-    rd.add_argument("--background", default="1,1,1", metavar="R,G,B", help="background colour, 0-1 each")
+    rd.add_argument(
+        "--background", default="1,1,1", metavar="R,G,B", help="background colour, 0-1 each (default white)"
+    )
     rd.add_argument("--interactive", action="store_true", help="replay in Exudyn's viewer (needs a display)")
     rd.add_argument("--quiet", action="store_true", help="no progress display")
     rd.set_defaults(handler=execute)

@@ -9,8 +9,12 @@ from .common import EXIT_FAILED, EXIT_OK, load, number
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    about = "compare gearbody with the independent ODE reference (exit 1 above tolerance)"
     val = sub.add_parser(
-        "validate", help="compare gearbody with the independent ODE reference (exit 1 above tolerance)"
+        "validate",
+        help=about,
+        description=f"{about[0].upper()}{about[1:]}: each scene is simulated by gearbody and by the"
+        " reference integrator and the mesh forces are compared, relative to the rated mesh force.",
     )
     val.add_argument("scenes", metavar="SCENE", nargs="*", help="scenes to validate (default: all)")
     val.add_argument("--short", action="store_true", help="short runs (as in the test suite)")

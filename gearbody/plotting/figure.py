@@ -10,13 +10,24 @@ from __future__ import annotations
 import base64
 import io
 import os
+import textwrap
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+    from matplotlib.text import Text
 
-__all__ = ["DEFAULT_SIZE_PX", "PathLike", "new_figure", "png_base64", "save_figure"]
+__all__ = [
+    "DEFAULT_SIZE_PX",
+    "PathLike",
+    "drop_overlapping",
+    "new_figure",
+    "png_base64",
+    "save_figure",
+    "set_title",
+]
 
 PathLike = str | os.PathLike[str]
 DEFAULT_SIZE_PX: tuple[int, int] = (1000, 600)
@@ -33,6 +44,41 @@ def new_figure(size_px: tuple[int, int] = DEFAULT_SIZE_PX, dpi: int = 100) -> Fi
     fig = Figure(figsize=(width_px / dpi, height_px / dpi), dpi=dpi, layout="constrained")
     FigureCanvasAgg(fig)
     return fig
+
+
+def set_title(ax: Axes, title: str, **kwargs) -> None:
+    """``ax.set_title(title)``, wrapped onto several lines where it is wider than the axes would fit."""
+    fig = ax.get_figure()
+    size_pt = float(kwargs.get("fontsize", 12)) if not isinstance(kwargs.get("fontsize"), str) else 12.0
+    axes_px = fig.get_figwidth() * fig.dpi * ax.get_position().width
+    chars = max(20, int(axes_px / (0.52 * size_pt * fig.dpi / 72)))  # a mean glyph is ~0.5 em wide
+    ax.set_title(textwrap.fill(title, chars, break_on_hyphens=False), **kwargs)
+
+
+def drop_overlapping(texts: list[Text], within: Axes | None = None) -> list[Text]:
+    """Hide every text of ``texts`` (most important first) that overlaps an earlier one or leaves the
+    figure (the axes ``within``, when given); returns those kept. Lays the figure out first, so extents
+    are the final ones."""
+    if not texts:
+        return []
+    fig = texts[0].get_figure()
+    if not hasattr(fig.canvas, "get_renderer"):  # a bare Figure(): measure on an Agg canvas
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        FigureCanvasAgg(fig)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    frame = fig.bbox if within is None else within.get_window_extent(renderer)
+    kept, boxes = [], []
+    for text in texts:
+        box = text.get_window_extent(renderer)
+        inside = box.x0 >= frame.x0 and box.y0 >= frame.y0 and box.x1 <= frame.x1 and box.y1 <= frame.y1
+        if inside and not any(box.overlaps(other) for other in boxes):
+            kept.append(text)
+            boxes.append(box)
+        else:
+            text.set_visible(False)
+    return kept
 
 
 def save_figure(fig: Figure, path: PathLike, dpi: int = 100) -> Path:

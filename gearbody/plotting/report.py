@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .figure import new_figure
+from .figure import new_figure, set_title
 from .spectrum import plot_labelled_spectrum
 
 if TYPE_CHECKING:
@@ -39,19 +39,22 @@ def kd_folded_figure(folded: FoldedSignal, title: str) -> Figure:
     ax.set_xlabel("mesh period [%]")
     ax.set_ylabel("K_d")
     ax.legend()
-    ax.set_title(title)
+    set_title(ax, title)
     return fig
 
 
-def tsa_figure(tsa: SynchronousAverage, name: str) -> Figure:
-    """The synchronous average of signal ``name`` over pinion revolutions, and its difference signal."""
+def tsa_figure(tsa: SynchronousAverage, name: str, unit: str = "") -> Figure:
+    """The synchronous average of signal ``name`` [``unit``] over pinion revolutions, and its difference
+    signal."""
     fig = new_figure((1100, 500), 100)
     ax = fig.add_subplot(2, 1, 1)
     deg = np.degrees(tsa.angle_rad)
     ax.plot(deg, tsa.average, lw=0.7)
     ax.set_title(f"TSA of {name} over {tsa.n_revs} pinion revolutions", fontsize=9)
+    ax.set_ylabel(f"average [{unit}]" if unit else "average")
     ax = fig.add_subplot(2, 1, 2)
     ax.plot(deg, tsa.difference(), lw=0.7, color="C3")
+    ax.set_ylabel(f"difference [{unit}]" if unit else "difference")
     ax.set_title("difference signal (mesh harmonics, first sidebands, shaft orders 1-2 removed)", fontsize=9)
     ax.set_xlabel("pinion angle [deg]")
     return fig

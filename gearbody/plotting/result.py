@@ -9,16 +9,27 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 from gearbody.analysis.dynamic_factor import INSTABILITY_KD, FoldedSignal
 from gearbody.analysis.spectrum import Spectrum, mesh_harmonics
 
-from .figure import DEFAULT_SIZE_PX, PathLike, new_figure, save_figure
+from .figure import DEFAULT_SIZE_PX, PathLike, new_figure, save_figure, set_title
 
-__all__ = ["harmonic_labels", "plot_kd_folded", "plot_kd_time", "plot_signals", "plot_spectrum"]
+__all__ = [
+    "harmonic_labels",
+    "plot_kd_folded",
+    "plot_kd_time",
+    "plot_signals",
+    "plot_spectrum",
+    "spectrum_figure",
+]
 
 def _threshold_line(ax, kd_threshold: float | None) -> None:
     if kd_threshold is not None:
@@ -56,7 +67,7 @@ def plot_kd_time(
     ax.set_xlabel("Time t [s]")
     ax.set_ylabel("Dynamic factor K_d [-]")
     if title:
-        ax.set_title(title)
+        set_title(ax, title)
     if kd_threshold is not None:
         ax.legend(loc="upper left")
     ax.grid(True, alpha=0.3)
@@ -81,7 +92,7 @@ def plot_signals(
     ax.set_xlabel("Time t [s]")
     ax.set_ylabel(ylabel)
     if title:
-        ax.set_title(title)
+        set_title(ax, title)
     if signals:
         ax.legend(loc="upper left", fontsize="small")
     ax.grid(True, alpha=0.3)
@@ -111,15 +122,14 @@ def plot_kd_folded(
     ax.set_xlabel("% of mesh period")
     ax.set_ylabel("K_d [-]")
     if title:
-        ax.set_title(title)
+        set_title(ax, title)
     ax.legend(loc="upper right")
     ax.grid(True, alpha=0.3)
     return save_figure(fig, path, dpi)
 
 
-def plot_spectrum(
+def spectrum_figure(
     spectrum: Spectrum,
-    path: PathLike,
     mesh_frequency_hz: float | None = None,
     shaft_frequencies_hz: Sequence[float] | Mapping[str, float] = (),
     title: str = "",
@@ -129,12 +139,14 @@ def plot_spectrum(
     max_harmonics: int = 20,
     size_px: tuple[int, int] = DEFAULT_SIZE_PX,
     dpi: int = 100,
-) -> Path:
-    """Amplitude spectrum against frequency [Hz] (as Figs. 13-16, 20).
+) -> Figure:
+    """The figure of :func:`plot_spectrum` (same arguments but ``path``), not saved.
+
+    Amplitude spectrum against frequency [Hz] (as Figs. 13-16, 20).
 
     Mesh harmonics k f_z <= fmax_hz (at most ``max_harmonics``) are marked by dashed lines labelled
-    f_z, 2f_z, ...; shaft frequencies by dotted lines, labelled by the mapping keys (plain text)
-    or f_s1, f_s2, ....
+    f_z, 2f_z, ... (aligned inwards at the edges); shaft frequencies by green lines named with their
+    frequency in a legend by the mapping keys (plain text) or f_s1, f_s2, .... Long titles wrap.
     ``log_amplitude`` uses a log y axis (bins below 1e-9 of the maximum are clipped to it).
     Pass ``ylabel`` with the signal's unit, e.g. "Acceleration amplitude [m/s^2]".
     """
@@ -156,12 +168,14 @@ def plot_spectrum(
         harmonics = mesh_harmonics(mesh_frequency_hz, fmax)[:max_harmonics]
         for f, label in zip(harmonics, harmonic_labels(harmonics.size), strict=True):
             ax.axvline(f, color="tab:red", linestyle="--", linewidth=0.8, alpha=0.8)
+            # a label at either edge of the axes is aligned inwards, so that it stays in the figure
+            align = "right" if f > 0.97 * fmax else "left" if f < 0.03 * fmax else "center"
             ax.text(
                 f,
                 1.0,
                 f"${label}$",
                 transform=label_transform,
-                ha="center",
+                ha=align,
                 va="bottom",
                 color="tab:red",
                 fontsize=8,
@@ -172,17 +186,48 @@ def plot_spectrum(
         shafts = [(str(k), float(v)) for k, v in shaft_frequencies_hz.items()]
     else:
         shafts = [(f"$f_{{s{i}}}$", float(v)) for i, v in enumerate(shaft_frequencies_hz, start=1)]
-    for label, f in shafts:
-        if f <= fmax:
-            ax.axvline(f, color="tab:green", linestyle=":", linewidth=1.0)
-            ax.text(
-                f, 0.97, label, transform=label_transform, ha="left", va="top", color="tab:green", fontsize=8
-            )
+    shown_shafts = [(label, f) for label, f in shafts if f <= fmax]
+    styles = (":", "-.", (0, (1, 3)), (0, (5, 2, 1, 2)))
+    for i, (label, f) in enumerate(shown_shafts):
+        # shaft lines lie close together at the low end: named in a legend, not next to the line
+        style = styles[i % len(styles)]
+        ax.axvline(f, color="tab:green", linestyle=style, linewidth=1.0, label=f"{label} = {f:.4g} Hz")
+    if shown_shafts:
+        ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
 
     ax.set_xlim(0.0, fmax)
     ax.set_xlabel("Frequency f [Hz]")
     ax.set_ylabel(ylabel)
     if title:
-        ax.set_title(title, pad=14 if mesh_frequency_hz is not None else 6)
+        set_title(ax, title, pad=14 if mesh_frequency_hz is not None else 6)
     ax.grid(True, alpha=0.3)
+    return fig
+
+
+def plot_spectrum(
+    spectrum: Spectrum,
+    path: PathLike,
+    mesh_frequency_hz: float | None = None,
+    shaft_frequencies_hz: Sequence[float] | Mapping[str, float] = (),
+    title: str = "",
+    fmax_hz: float | None = None,
+    ylabel: str = "Amplitude [signal units]",
+    log_amplitude: bool = False,
+    max_harmonics: int = 20,
+    size_px: tuple[int, int] = DEFAULT_SIZE_PX,
+    dpi: int = 100,
+) -> Path:
+    """Amplitude spectrum against frequency [Hz] as PNG at ``path`` (:func:`spectrum_figure`)."""
+    fig = spectrum_figure(
+        spectrum,
+        mesh_frequency_hz,
+        shaft_frequencies_hz,
+        title,
+        fmax_hz,
+        ylabel,
+        log_amplitude,
+        max_harmonics,
+        size_px,
+        dpi,
+    )
     return save_figure(fig, path, dpi)

@@ -42,6 +42,7 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
         )
     )
     name = result.vibration_signal_name
+    t_win = result.time_s[win]
     spec = amplitude_spectrum(result[name][win], result.sample_rate_hz)
     z1, z2 = result.teeth(0)
     shafts = {"f_1": f_mesh / z1, "f_2": f_mesh / z2} if f_mesh > 0 else {}
@@ -52,7 +53,8 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
             out / "spectrum.png",
             mesh_frequency_hz=f_mesh if f_mesh > 0 else None,
             shaft_frequencies_hz=shafts,
-            title=f"{title}: spectrum of {name}",
+            title=f"{title}: spectrum of {name}, t = {t_win[0]:.3g}-{t_win[-1]:.3g} s"
+            f" (last {result.FINAL_FRACTION:.0%} of the run, run-up left out)",
             fmax_hz=min(result.sample_rate_hz / 2, 8 * f_mesh if f_mesh > 0 else 1e9),
             ylabel=f"amplitude [{unit}]",
             log_amplitude=True,

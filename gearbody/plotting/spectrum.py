@@ -13,7 +13,7 @@ from gearbody.analysis.peak_report import checked_peaks
 from gearbody.analysis.peaks import LabelledPeak
 from gearbody.analysis.spectrum import Spectrum
 
-from .figure import new_figure
+from .figure import drop_overlapping, new_figure, set_title
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -31,7 +31,8 @@ def plot_labelled_spectrum(
     log: bool = True,
 ) -> Axes:
     """Amplitude spectrum with its peaks marked: explained peaks with their labels (rotated, small, red),
-    unexplained ones in grey with their frequency.
+    unexplained ones in grey with their frequency. Where labels would overlap, the explained and then
+    the stronger peak keeps its label; every peak keeps its marker.
 
     Draws into ``ax``, or into a new Agg figure (no pyplot, global backend untouched) when None; returns
     the axes (``save_figure(ax.figure, path)`` writes it).
@@ -50,11 +51,12 @@ def plot_labelled_spectrum(
         a = np.where(a > 0, a, np.nan)
     ax.plot(f[keep], a[keep], linewidth=0.6, color="tab:blue")
     shown = [p for p in peaks if f_max_hz is None or p.frequency_hz <= f_max_hz]
-    for p in shown:
+    labels = []
+    for p in sorted(shown, key=lambda p: (not p.explained, -p.amplitude)):
         colour = "tab:red" if p.explained else "0.5"
         text = p.label if p.explained else f"{p.frequency_hz:.1f} Hz"
         ax.plot([p.frequency_hz], [p.amplitude], marker="v", markersize=3, linestyle="none", color=colour)
-        ax.annotate(
+        label = ax.annotate(
             text,
             (p.frequency_hz, p.amplitude),
             xytext=(0, 5),
@@ -65,14 +67,19 @@ def plot_labelled_spectrum(
             va="bottom",
             color=colour,
         )
+        label.set_in_layout(False)  # the y headroom below holds them; the layout stays put when some hide
+        labels.append(label)
     if log:
         ax.set_yscale("log")
     top = np.nanmax(a[keep]) if np.any(np.isfinite(a[keep])) else None
     if top is not None and top > 0:
-        ax.set_ylim(top=top * (300.0 if log else 1.4))  # room for the rotated labels
+        # room for the rotated labels: ~1/4 of the axes height above the highest line
+        decades = np.log10(top / np.nanmin(a[keep])) if log else 0.0
+        ax.set_ylim(top=top * (10.0 ** max(2.5, decades / 3.0) if log else 1.4))
     ax.set_xlim(0.0, f_max_hz if f_max_hz is not None else f[-1])
     ax.set_xlabel("Frequency f [Hz]")
     ax.set_ylabel(f"Amplitude [{unit}]" if unit else "Amplitude")
     if title:
-        ax.set_title(title)
+        set_title(ax, title)
+    drop_overlapping(labels, within=ax)
     return ax

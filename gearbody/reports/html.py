@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from gearbody.analysis import (
+    KinematicLine,
     KinematicSources,
     amplitude_spectrum,
     condition_indicators_from_average,
@@ -27,15 +28,43 @@ from gearbody.plotting.figure import png_base64
 from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure, tsa_figure
 from gearbody.result import Result
 
-__all__ = ["report_sections", "write_report"]
+__all__ = ["PEAK_COLUMNS", "report_sections", "spectrum_lines", "write_report"]
 
 MIN_TSA_REVOLUTIONS = 2
+WHEEL_SIDEBANDS = 3
+"""Sideband orders catalogued for a shaft that carries no pinion (closely spaced: few, or they would
+explain nearly any peak)."""
 
 
-def _table(rows: list[dict[str, Any]], columns: list[str] | None = None) -> str:
+def spectrum_lines(input_hz: float, teeth: list[tuple[int, int]], f_max_hz: float) -> list[KinematicLine]:
+    """The kinematic lines the report labels peaks with: 6 mesh harmonics, 30 shaft orders, and
+    sidebands of a pinion's rotation out to half way to the next harmonic (z_pinion // 2 orders), of
+    other shafts :data:`WHEEL_SIDEBANDS` orders."""
+    sources = KinematicSources.gear_train(input_hz, teeth)
+    sidebands = {shaft.name: WHEEL_SIDEBANDS for shaft in sources.shafts}
+    for (z_pinion, _), mesh in zip(teeth, sources.meshes, strict=True):
+        pinion = mesh.shafts[0]
+        sidebands[pinion] = max(sidebands[pinion], z_pinion // 2)
+    return kinematic_lines(sources, f_max_hz, harmonics=6, sidebands=sidebands, shaft_orders=30)
+
+
+PEAK_COLUMNS = {
+    "frequency_hz": "f [Hz]",
+    "amplitude": "amplitude [{unit}]",
+    "prominence_db": "prominence over the local floor [dB]",
+    "label": "kinematic line",
+    "offset_hz": "offset from the line [Hz]",
+}
+"""Header of each column of the peaks table (``{unit}``: the vibration signal's unit)."""
+
+
+def _table(
+    rows: list[dict[str, Any]], columns: list[str] | None = None, headers: dict[str, str] | None = None
+) -> str:
     if not rows:
         return "<p><em>none</em></p>"
     columns = columns or list(rows[0])
+    headers = headers or {}
 
     def cell(v):
         if v is None:
@@ -46,7 +75,7 @@ def _table(rows: list[dict[str, Any]], columns: list[str] | None = None) -> str:
             return html.escape("; ".join(map(str, v)))
         return html.escape(str(v))
 
-    head = "".join(f"<th>{html.escape(c)}</th>" for c in columns)
+    head = "".join(f"<th>{html.escape(headers.get(c, c))}</th>" for c in columns)
     body = "".join(
         "<tr>" + "".join(f"<td>{cell(r.get(c, ''))}</td>" for c in columns) + "</tr>" for r in rows
     )
@@ -71,15 +100,16 @@ def report_sections(result: Result) -> dict[str, Any]:
     peaks = []
     if f_mesh > 0:
         f_max = min(result.sample_rate_hz / 2, 6 * f_mesh)
-        sources = KinematicSources.gear_train(f_mesh / z1, teeth)
-        lines = kinematic_lines(sources, f_max, harmonics=6, sidebands=3, shaft_orders=30)
+        lines = spectrum_lines(f_mesh / z1, teeth, f_max)
         peaks = label_peaks(
             spec, lines, tolerance_hz=1.5 * spec.resolution_hz, min_prominence_db=12.0, max_peaks=40,
             f_max_hz=f_max,
         )
-        fig = labelled_spectrum_figure(spec, peaks, title=f"spectrum of {name}", unit=unit, f_max_hz=f_max)
+        title = f"spectrum of {name} [{unit}], last {result.FINAL_FRACTION:.0%} of the run"
+        fig = labelled_spectrum_figure(spec, peaks, title=title, unit=unit, f_max_hz=f_max)
         out["figures"]["spectrum"] = png_base64(fig)
     out["peaks"] = peaks_to_rows(peaks)
+    out["unit"] = unit
 
     # K_d folded over the mesh period
     if f_mesh > 0:
@@ -97,7 +127,7 @@ def report_sections(result: Result) -> dict[str, Any]:
         tsa = synchronous_average(signal[win], angle, teeth=z1)
         out["indicators"] = condition_indicators_from_average(tsa).as_dict()
         out["tsa_revolutions"] = tsa.n_revs
-        fig = tsa_figure(tsa, name)
+        fig = tsa_figure(tsa, name, unit)
         out["figures"]["tsa"] = png_base64(fig)
     else:
         out["tsa_note"] = (
@@ -131,7 +161,9 @@ def write_report(result: Result, path: str | Path) -> Path:
         img.get("kd_folded", "<p>no mesh frequency</p>"),
         "<h2>Labelled spectrum</h2>",
         img.get("spectrum", ""),
-        _table(s["peaks"]),
+        _table(
+            s["peaks"], list(PEAK_COLUMNS), {k: v.format(unit=s["unit"]) for k, v in PEAK_COLUMNS.items()}
+        ),
         "<h2>Synchronous average and condition indicators</h2>",
         img.get("tsa", f"<p>{html.escape(s.get('tsa_note', ''))}</p>"),
         _table([{"indicator": k, "value": v} for k, v in s["indicators"].items()]),
