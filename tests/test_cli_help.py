@@ -18,8 +18,12 @@ def _commands() -> dict[str, argparse.ArgumentParser]:
 def test_every_command_is_described_in_the_overview_and_its_own_help():
     overview = _parser().format_help()
     for name, parser in _commands().items():
-        line = next((ln for ln in overview.splitlines() if ln.strip().startswith(name + " ")), "")
-        assert len(line.split()) > 2, f"{name} has no description in gearbody --help"
+        lines = overview.splitlines()
+        at = next((k for k, ln in enumerate(lines) if ln.split()[:1] == [name]), None)
+        assert at is not None, f"{name} is not listed in gearbody --help"
+        # argparse puts a long command's description on the next line, indented
+        text = lines[at].split()[1:] or (lines[at + 1].split() if at + 1 < len(lines) else [])
+        assert len(text) > 2, f"{name} has no description in gearbody --help"
         assert parser.description, f"gearbody {name} --help has no description"
 
 

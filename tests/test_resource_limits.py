@@ -212,7 +212,10 @@ def test_render_frames_are_bounded_before_anything_is_simulated(tmp_path, capsys
     t0 = time.perf_counter()
     assert main(["render", "one-stage", "--frames", "100000", "--quiet", "--out", str(tmp_path)]) == 2
     assert time.perf_counter() - t0 < 5.0 and not any(tmp_path.iterdir())
-    assert f"frames = 100000: must be a whole number in [1, {MAX_FRAMES}]" in capsys.readouterr().err
+    assert f"--frames = 100000: must be a whole number >= 1 and <= {MAX_FRAMES}" in capsys.readouterr().err
+    from gearbody.cli import render as render_command
+
+    assert render_command.MAX_FRAMES == MAX_FRAMES  # the command line states the renderer's bound
     with pytest.raises(RenderError, match="animated GIF holds every frame in memory"):
         check_frames(1000, 800, 600, "gif")
     check_frames(1000, 800, 600, "none")

@@ -21,6 +21,8 @@ from .common import (
     usage_error,
 )
 
+MAX_FRAMES = 2000  # gearbody.render.MAX_FRAMES (not imported here: the renderer loads on use)
+
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
@@ -50,9 +52,9 @@ def register(sub) -> argparse.ArgumentParser:
     )
     rd.add_argument(
         "--frames",
-        type=number(whole=True, ge=1, le=10000),
+        type=number(whole=True, ge=1, le=MAX_FRAMES),
         metavar="N",
-        help="number of frames (default 24; --interactive: 400)",
+        help=f"number of frames, at most {MAX_FRAMES} (default 24; --interactive: 400)",
     )
     rd.add_argument(
         "--start",
