@@ -201,7 +201,7 @@ BAD_OPTIONS = [
     (["sweep", "one-stage", "--out", "x"], "--seeds", "-2", ">= 1"),
     (["sweep", "one-stage", "--out", "x"], "--study-seed", "-1", ">= 0"),
     (["sweep", "one-stage", "--out", "x"], "--t-end", "inf", "> 0"),
-    (["render", "one-stage"], "--frames", "0", ">= 1 and <= 10000"),
+    (["render", "one-stage"], "--frames", "0", ">= 1 and <= 2000"),
     (["render", "one-stage"], "--zoom", "0", ">= 0.05 and <= 50"),
     (["render", "one-stage"], "--zoom", "nan", ">= 0.05"),
     (["render", "one-stage"], "--fps", "0", ">= 0.1 and <= 120"),
