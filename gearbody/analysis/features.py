@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .dynamic_factor import separation_stats
-from .indicators import condition_indicators_from_average
+from .indicators import condition_indicators_from_average, rms
 from .spectrum import amplitude_spectrum, peak_near
 from .tsa import synchronous_average
 
@@ -311,7 +311,7 @@ def evaluate_feature(spec: FeatureSpec | str, record: Record) -> float:
         return float(separation_stats(force, record.time_s[mask]).separated_fraction)
     x = record.signal(str(o["signal"]))[mask]
     if name == "rms":
-        return float(np.sqrt(np.mean(x**2)))
+        return rms(x)
     if name == "line_amplitude":
         f = line_frequency_hz(
             record.pinion_hz(mask),
