@@ -119,6 +119,47 @@ def test_a_tiny_inertia_is_refused_relative_to_the_model_before_building():
     assert "other coordinates reach 2.7e+03 Hz" in msg  # relative to the rest of the model
 
 
+def test_a_light_motor_on_a_steep_slip_characteristic_is_refused_by_its_damping_rate():
+    """The simulation fuzzer's slow case: 1.3e-5 kg m^2 of motor at w_s = 1 rad/s has a slip slope of
+    2 M_b / (s_b w_s) = 4.87e4 N m s/rad, a real root near -3.7e9 1/s; on main the run took 243 s to stop
+    at its memory budget after 6.6 ms simulated."""
+    from gearbody.physics import viscous_equivalent_Nms
+
+    overrides = [
+        "operation.t_end_s=0.01",
+        "design.mesh.stiffness_single_N_per_m=1e5",
+        "design.motor.inertia_kg_m2=1.3080523287051801e-05",
+        "design.motor.synchronous_speed_rad_s=1.0",
+    ]
+    sc = load_scenario("lateral-8dof", overrides)
+    t0 = time.perf_counter()
+    with pytest.raises(InputError) as info:
+        simulate(sc)
+    assert time.perf_counter() - t0 < 2.0
+    msg = str(info.value)
+    slope = viscous_equivalent_Nms(1750.0, 0.0719, 1.0)
+    rate_hz = slope / (2 * 1.3080523287051801e-05) / (2 * math.pi)
+    assert (
+        f"design.motor.inertia_kg_m2 = 1.30805e-05 kg m^2: against its damping ({slope:.3g} N m s/rad" in msg
+    )
+    assert (
+        "motor's slip characteristic" in msg
+        and f"damping rate C / (2 M) / 2 pi of at least {rate_hz:.3g} Hz" in msg
+    )
+
+
+def test_a_stiff_coupling_damper_on_a_light_pinion_names_its_damping_key():
+    from gearbody.assembly import check_resolved_modes
+
+    sc = load_scenario("one-stage", ["design.coupling.damping_Nms_per_rad=1e6"])
+    with pytest.raises(
+        InputError,
+        match=r"design.stages.1.pinion.inertia_kg_m2 = .*mostly from "
+        r"design.shafts.1.damping_Nms_per_rad\) this gives a damping rate",
+    ):
+        check_resolved_modes(sc)
+
+
 def test_a_tiny_gear_mass_of_a_lateral_model_is_named():
     from gearbody.assembly import check_resolved_modes
 
