@@ -44,6 +44,12 @@ class StudySpecError(StudyError, InputError):
     """A study specification (--vary, --random, --cases) is invalid (exit code 2)."""
 
 
+class CalibrationFailed(GearbodyError):
+    """Every evaluation of a calibration failed; all are recorded (exit code 1)."""
+
+    exit_code = 1
+
+
 class ReferenceMismatch(GearbodyError):
     """gearbody and the independent reference disagree beyond the validation tolerance (exit code 1)."""
 
@@ -51,6 +57,7 @@ class ReferenceMismatch(GearbodyError):
 
 
 __all__ = [
+    "CalibrationFailed",
     "GearbodyError",
     "InputError",
     "ReferenceMismatch",

@@ -1,4 +1,4 @@
-"""Command line: ``gearbody list | run | modes | mesh | validate | sweep | sensitivity | render``.
+"""Command line: ``gearbody list | run | modes | mesh | validate | sweep | sensitivity | calibrate | render``.
 
 One module per command (``register(sub)`` adds its parser, ``execute(args)`` runs it; heavy imports
 happen inside ``execute``), the shared options and exit codes in :mod:`.common`. Exit codes: 0 ok,
@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from . import listing, mesh, modes, render, run, sensitivity, sweep, validate
+from . import calibrate, listing, mesh, modes, render, run, sensitivity, sweep, validate
 from .common import EXIT_INTERRUPTED
 
 __all__ = ["main"]
@@ -28,7 +28,7 @@ EPILOG = """examples:
   gearbody render one-stage --result runs/one-stage --view front --frame gears
 """
 
-COMMANDS = (listing, run, modes, mesh, validate, sweep, sensitivity, render)
+COMMANDS = (listing, run, modes, mesh, validate, sweep, sensitivity, calibrate, render)
 """In the order of ``gearbody --help``."""
 
 

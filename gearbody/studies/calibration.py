@@ -85,17 +85,24 @@ class Parameter:
 
 @dataclass(frozen=True)
 class Target:
-    """A feature to match: its name (a feature spec), the target value and its uncertainty (same unit)."""
+    """A feature to match: its name (a feature spec), the target value and its uncertainty (same unit),
+    and optionally the case (a named set of extra overrides, :mod:`.scene_calibration`) it is read from."""
 
     feature: str
     value: float
     sigma: float
+    case: str = ""
+
+    @property
+    def label(self) -> str:
+        """``feature`` or ``feature@case``: the target's key in features and residuals."""
+        return f"{self.feature}@{self.case}" if self.case else self.feature
 
     def __post_init__(self) -> None:
         if not math.isfinite(self.value):
-            raise CalibrationError(f"target {self.feature}: value {self.value!r} must be finite")
+            raise CalibrationError(f"target {self.label}: value {self.value!r} must be finite")
         if not (math.isfinite(self.sigma) and self.sigma > 0):
-            raise CalibrationError(f"target {self.feature}: sigma {self.sigma!r} must be finite and > 0")
+            raise CalibrationError(f"target {self.label}: sigma {self.sigma!r} must be finite and > 0")
 
 
 class EvaluationCache:
@@ -106,7 +113,8 @@ class EvaluationCache:
         self.path = Path(path) if path is not None else None
         self.fingerprint = fingerprint
         self.values: dict[str, dict[str, float] | None] = {}
-        self.replayed = 0
+        self.replayed = 0  # evaluations answered from the file read at the start
+        self.recorded: set[str] = set()
         if self.path is not None and self.path.exists():
             lines = self.path.read_text().splitlines()
             head = json.loads(lines[0]) if lines else {}
@@ -123,6 +131,7 @@ class EvaluationCache:
                     continue
                 self.values[item["point"]] = item["features"]
                 kept.append(line)
+            self.recorded = set(self.values)
             if len(kept) < len(lines) or not self.path.read_text().endswith("\n"):
                 self.path.write_text("\n".join(kept) + "\n")  # new lines must not join a cut one
         elif self.path is not None:
@@ -143,7 +152,8 @@ class EvaluationCache:
         """Features of every point: cached ones replayed, the others evaluated as one batch and recorded."""
         keys = [self.key(p) for p in points]
         todo = [i for i, k in enumerate(keys) if k not in self.values]
-        self.replayed += len(points) - len(todo)
+        self.replayed += sum(k in self.recorded for k in set(keys))
+        self.recorded -= set(keys)  # each recorded evaluation counted once
         if todo:
             fresh = evaluate([points[i] for i in todo])
             for i, features in zip(todo, fresh, strict=True):
@@ -170,15 +180,16 @@ class CalibrationResult:
 
     def table(self) -> str:
         """Parameters with their uncertainties, then each target's fit, as plain text."""
-        lines = [f"{'parameter':40s} {'value':>14s} {'1-sigma':>12s}"]
+        w = max([len("parameter"), *map(len, self.parameters), *(len(t.label) for t in self.targets)])
+        lines = [f"{'parameter':{w}s} {'value':>14s} {'1-sigma':>12s}"]
         for k, v in self.parameters.items():
-            lines.append(f"{k:40s} {v:14.6g} {self.sigma[k]:12.3g}")
+            lines.append(f"{k:{w}s} {v:14.6g} {self.sigma[k]:12.3g}")
         lines.append("")
-        lines.append(f"{'feature':40s} {'target':>12s} {'fitted':>12s} {'residual/sigma':>15s}")
+        lines.append(f"{'feature':{w}s} {'target':>14s} {'fitted':>12s} {'residual/sigma':>15s}")
         for t in self.targets:
             lines.append(
-                f"{t.feature:40s} {t.value:12.6g} {self.features[t.feature]:12.6g} "
-                f"{self.residuals[t.feature]:15.3g}"
+                f"{t.label:{w}s} {t.value:14.6g} {self.features[t.label]:12.6g} "
+                f"{self.residuals[t.label]:15.3g}"
             )
         lines.append(
             f"cost (chi^2/2) {self.cost:.4g} after {self.evaluations} evaluations "
@@ -229,9 +240,9 @@ def calibrate(
         return {p.key: p.from_unit(x) for p, x in zip(parameters, u, strict=True)}
 
     def residuals_of(features) -> np.ndarray:
-        if features is None or any(not math.isfinite(features.get(t.feature, math.nan)) for t in targets):
+        if features is None or any(not math.isfinite(features.get(t.label, math.nan)) for t in targets):
             return np.full(len(targets), FAILED_RESIDUAL)
-        return np.array([(features[t.feature] - t.value) / t.sigma for t in targets])
+        return np.array([(features[t.label] - t.value) / t.sigma for t in targets])
 
     seen: set[str] = set()
 
@@ -271,8 +282,8 @@ def calibrate(
         parameters=values,
         sigma=dict(zip(names, map(float, sd), strict=True)),
         correlation=corr,
-        features={t.feature: float(features.get(t.feature, math.nan)) for t in targets},
-        residuals={t.feature: float(x) for t, x in zip(targets, r0, strict=True)},
+        features={t.label: float(features.get(t.label, math.nan)) for t in targets},
+        residuals={t.label: float(x) for t, x in zip(targets, r0, strict=True)},
         cost=0.5 * float(r0 @ r0),
         history=history,
         evaluations=len(history),
