@@ -188,3 +188,37 @@ def test_known_stiffness_damping_and_error_are_recovered_from_a_wrong_start(tmp_
     assert fit.sigma[C] / truth[C] > fit.sigma[K] / truth[K]  # damping is the least determined
     assert fit.cost < 1e-2
     assert res.simulations == fit.evaluations
+
+
+def test_ctrl_c_keeps_the_evaluations_and_the_rerun_ends_as_an_uninterrupted_fit(
+    tmp_path, capsys, monkeypatch
+):
+    from gearbody.studies import scene_calibration
+
+    def args(out):
+        return [
+            "calibrate", "one-stage", "--t-end", "0.02", *(x for o in STEADY for x in ("--set", o)),
+            "--param", f"{K}=0.9e9:1.5e9:log", "--target", A1, "300", "30",
+            "--budget", "4", "--batch", "1", "--polish-evaluations", "3", "--workers", "1", "--quiet",
+            "--out", str(out),
+        ]  # fmt: skip
+
+    assert main(args(tmp_path / "whole")) == 0
+    whole = json.loads((tmp_path / "whole" / "calibration.json").read_text())
+    real, calls = scene_calibration.run_jobs, []
+
+    def interrupted(*a, **kw):
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real(*a, **kw)
+
+    monkeypatch.setattr(scene_calibration, "run_jobs", interrupted)
+    assert main(args(tmp_path / "cut")) == 130
+    err = capsys.readouterr().err
+    assert "interrupted: 2 evaluations recorded" in err and "rerun the same command to resume" in err
+    monkeypatch.setattr(scene_calibration, "run_jobs", real)
+    assert main(args(tmp_path / "cut")) == 0
+    resumed = json.loads((tmp_path / "cut" / "calibration.json").read_text())
+    assert resumed["replayed"] == 2 and resumed["simulations"] == whole["simulations"] - 2
+    assert resumed["parameters"] == whole["parameters"] and resumed["history"] == whole["history"]

@@ -281,6 +281,11 @@ def calibrate_scene(
             seed=seed,
             cache=cache,
         )
+    except KeyboardInterrupt:
+        raise KeyboardInterrupt(
+            f"interrupted: {len(cache.values)} evaluations recorded in {cache.path}; rerun the same command "
+            "to resume"
+        ) from None
     finally:
         if bar["bar"] is not None:
             bar["bar"].close()
