@@ -222,3 +222,19 @@ def test_ctrl_c_keeps_the_evaluations_and_the_rerun_ends_as_an_uninterrupted_fit
     resumed = json.loads((tmp_path / "cut" / "calibration.json").read_text())
     assert resumed["replayed"] == 2 and resumed["simulations"] == whole["simulations"] - 2
     assert resumed["parameters"] == whole["parameters"] and resumed["history"] == whole["history"]
+
+
+def test_the_docs_commands_parse():
+    import re
+    import shlex
+    from pathlib import Path
+
+    from gearbody.cli import _parser
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "calibration.md").read_text()
+    blocks = re.findall(r"```sh\n(.*?)```", text, re.S)
+    assert len(blocks) >= 2
+    for block in blocks:
+        words = shlex.split(block.replace("\\\n", " "))
+        assert words[:2] == ["gearbody", "calibrate"]
+        _parser().parse_args(words[1:])

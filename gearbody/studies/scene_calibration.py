@@ -343,7 +343,7 @@ def _write_outputs(
     text = (
         f"# Calibration of {label}\n\n```\n{fit.table()}\n```\n\n"
         f"{stats['simulations']} simulations in this run, {wall:.1f} s wall; "
-        f"cases: {', '.join(repr(c) for c in cases) or 'the scene only'}. "
+        f"cases: {', '.join(repr(c) for c in cases if c) or 'the scene only'}. "
         f"Rerun the fitted scene: `gearbody run {out / 'calibrated.toml'}`.\n"
     )
     write_text(out / "calibration.md", text)
