@@ -238,3 +238,36 @@ def test_the_docs_commands_parse():
         words = shlex.split(block.replace("\\\n", " "))
         assert words[:2] == ["gearbody", "calibrate"]
         _parser().parse_args(words[1:])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("executor", ["pool", "dask"])
+def test_a_process_pool_and_a_dask_cluster_give_the_serial_fit(tmp_path, executor):
+    """Two cases of a point and the points of a batch run in parallel; the fit is bit-identical."""
+    import contextlib
+
+    params = [Parameter(K, 0.9e9, 1.5e9, log=True), Parameter(E, 5.0, 30.0)]
+    targets = [Target(A1, 400.0, 4.0, "low"), Target(A2, 70.0, 0.7, "high")]
+    cases = {"low": [f"{C}=5000"], "high": [f"{C}=9000"]}
+    kw = dict(overrides=["operation.t_end_s=0.02", *STEADY], cases=cases, budget=4, batch=2,
+              polish_evaluations=3, progress=False)  # fmt: skip
+    serial = calibrate_scene("one-stage", params, targets, out=tmp_path / "serial", workers=1, **kw).fit
+    with contextlib.ExitStack() as stack:
+        if executor == "dask":
+            from dask.distributed import LocalCluster
+
+            cluster = stack.enter_context(
+                LocalCluster(
+                    n_workers=2,
+                    processes=True,
+                    threads_per_worker=1,
+                    host="127.0.0.1",
+                    dashboard_address=":0",
+                )  # fmt: skip
+            )
+            where = {"scheduler": cluster.scheduler_address}
+        else:
+            where = {"workers": 2}
+        res = calibrate_scene("one-stage", params, targets, out=tmp_path / executor, **where, **kw)
+    assert res.fit.parameters == serial.parameters and res.fit.history == serial.history
+    assert res.simulations == 2 * res.fit.evaluations
