@@ -167,3 +167,29 @@ def test_cli_render_simulates_keeps_the_result_and_rerenders_it(tmp_path):
     assert sorted(p.name for p in out.glob("frame_*.png")) == ["frame_0000.png"]
     assert not (out / "animation.gif").exists()  # the old movie went with the old frames
     assert main([*args, "--result", str(out), "--t-end", "1", "--out", str(out), "--quiet"]) == 2
+
+
+def test_the_mesh_frame_is_centred_on_the_pitch_point_and_shows_both_gears_teeth(one_stage):
+    """Issue 17: a large --zoom of --frame gears centred inside the wheel and showed its hub."""
+    sc, res = one_stage
+    layout = build_layout(sc)
+    (pinion, gp), (wheel, gw) = layout.gears[:2]
+    lo, hi = (np.array(v) for v in layout.mesh_bounds_m())
+    centre = 0.5 * (lo + hi)[:2]
+    to_pinion = np.hypot(*(centre - np.array(pinion.axis_xy_m)))
+    to_wheel = np.hypot(*(centre - np.array(wheel.axis_xy_m)))
+    assert to_pinion / to_wheel == pytest.approx(gp.teeth / gw.teeth)  # the operating pitch point
+    assert to_pinion == pytest.approx(gp.pitch_radius_m, rel=1e-4)
+    assert hi[0] - lo[0] == pytest.approx(12 * gp.module_m)
+    ((_, img),) = render_images(
+        sc, res, [0.02], RenderOptions(width_px=W, height_px=H, view="front", frame="mesh")
+    )
+    colours, counts = np.unique(img.reshape(-1, 3), axis=0, return_counts=True)
+    top = colours[np.argsort(counts)[::-1][:3]]
+    shares = np.sort(counts)[::-1][:3] / counts.sum()
+    assert shares[1] > 0.2  # two gears each fill a good part of the picture (the third: background)
+    assert not any(np.all(c == 255) for c in top[:2])
+    # the teeth interleave: along the middle column the colour changes several times
+    col = img[:, W // 2].astype(int)
+    changes = np.count_nonzero(np.abs(np.diff(col, axis=0)).sum(axis=1) > 60)
+    assert changes >= 4

@@ -85,13 +85,14 @@ def register(sub) -> argparse.ArgumentParser:
         "--zoom",
         type=number(ge=0.05, le=50),
         default=1.0,
-        help="magnification (default 1 = whole drive or all gears)",
+        help="magnification about the centre of the --frame box (default 1: the box fills the picture)",
     )
     rd.add_argument(
         "--frame",
-        choices=("drive", "gears"),
+        choices=("drive", "gears", "mesh"),
         default="drive",
-        help="what the camera fits: the whole drive (default) or the gears (hides motor and machine)",
+        help="what the camera fits: the whole drive (default), the gears, or the first stage's mesh (its "
+        "pitch point +- 6 modules: the teeth in contact); gears and mesh hide motor and machine",
     )
     rd.add_argument(
         "--housing",

@@ -40,6 +40,10 @@ COUPLING = (0.45, 0.45, 0.48, 1.0)
 SHAFT_SHEAR_STRESS_PA = 30e6
 
 
+MESH_WINDOW_MODULES = 6.0
+"""Half-size of the ``frame="mesh"`` camera box in modules: the teeth in contact and 2-3 pairs each side."""
+
+
 @dataclass(frozen=True)
 class Cylinder:
     """Tube along z from z0_m to z1_m (body or world frame), centred on (x_m, y_m)."""
@@ -127,6 +131,20 @@ class Layout:
     @property
     def gears(self) -> list[tuple[Body, GearShape]]:
         return [(b, p) for b in self.bodies for p in b.parts if isinstance(p, GearShape)]
+
+    def mesh_bounds_m(
+        self, modules: float = MESH_WINDOW_MODULES
+    ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """Box around the first stage's mesh: ``modules`` modules each side of the pitch point in the
+        gears' plane (the teeth in contact and their neighbours), the face width along the axes."""
+        (pinion, gp), (wheel, gw) = self.gears[:2]
+        (px, py), (wx, wy) = pinion.axis_xy_m, wheel.axis_xy_m
+        share = gp.teeth / (gp.teeth + gw.teeth)  # the operating pitch point divides the centre distance
+        cx, cy = px + share * (wx - px), py + share * (wy - py)
+        h = modules * max(gp.module_m, gw.module_m)
+        z0 = min(gp.z_m - gp.face_width_m / 2, gw.z_m - gw.face_width_m / 2)
+        z1 = max(gp.z_m + gp.face_width_m / 2, gw.z_m + gw.face_width_m / 2)
+        return (cx - h, cy - h, z0), (cx + h, cy + h, z1)
 
     def bounds_m(
         self, gears_only: bool = False

@@ -26,6 +26,10 @@ VIEWS = {  # azimuth, elevation in degrees: the eye's direction from the drive's
 }
 
 
+FRAMES = ("drive", "gears", "mesh")
+"""What the camera fits: the whole drive, the gears, or the first stage's mesh (pitch point +- 6 modules)."""
+
+
 @dataclass
 class RenderOptions:
     """Picture settings; sizes in pixels, angles in degrees."""
@@ -36,8 +40,8 @@ class RenderOptions:
     azimuth_deg: float | None = None
     elevation_deg: float | None = None
     zoom: float = 1.0
-    frame: str = "drive"  # what the camera fits: "drive" (everything) or "gears"
-    machines: bool | None = None  # draw motor and driven machine; None: unless frame == "gears"
+    frame: str = "drive"  # what the camera fits: "drive" (everything), "gears", or "mesh" (stage 1's teeth)
+    machines: bool | None = None  # draw motor and driven machine; None: only when frame == "drive"
     background: tuple[float, float, float] = (1.0, 1.0, 1.0)
     housing: bool | None = None  # None: as the scenario's visual.housing
     threads: int = 0  # raytracer threads; 0 = all cores
@@ -51,8 +55,8 @@ class RenderOptions:
             raise RenderError(f"view = {self.view!r}: must be one of {', '.join(VIEWS)}")
         if not 0.05 <= self.zoom <= 50:
             raise RenderError(f"zoom = {self.zoom:g}: must lie in [0.05, 50] (1 = whole drive)")
-        if self.frame not in ("drive", "gears"):
-            raise RenderError(f"frame = {self.frame!r}: must be 'drive' or 'gears'")
+        if self.frame not in FRAMES:
+            raise RenderError(f"frame = {self.frame!r}: must be one of {', '.join(map(repr, FRAMES))}")
         if self.elevation_deg is not None and not -90 <= self.elevation_deg <= 90:
             raise RenderError(f"elevation_deg = {self.elevation_deg:g}: must lie in [-90, 90]")
         if any(not 0 <= c <= 1 for c in self.background):
@@ -177,7 +181,7 @@ class VisualSystem:
         self.options = options or RenderOptions()
         self.options.check()
         o = self.options
-        self.show_machines = o.machines if o.machines is not None else o.frame != "gears"
+        self.show_machines = o.machines if o.machines is not None else o.frame == "drive"
         self.SC = exu.SystemContainer()
         self.mbs = self.SC.AddSystem()
         statics = []
@@ -232,7 +236,10 @@ class VisualSystem:
         az = o.azimuth_deg if o.azimuth_deg is not None else az
         el = o.elevation_deg if o.elevation_deg is not None else el
         R = camera_rotation(az, el)
-        lo, hi = (np.array(v) for v in self.layout.bounds_m(gears_only=o.frame == "gears"))
+        if o.frame == "mesh":
+            lo, hi = (np.array(v) for v in self.layout.mesh_bounds_m())
+        else:
+            lo, hi = (np.array(v) for v in self.layout.bounds_m(gears_only=o.frame == "gears"))
         centre = 0.5 * (lo + hi)
         # visible height: the box's extent on screen (projected corners), with a small margin
         corners = np.array(
