@@ -1,0 +1,86 @@
+"""Mesh kinematics of a pair whose centres move in the plane: the planetary stage's sun-planet (external)
+and ring-planet (internal) meshes, with exact involute geometry. Engine-free, compiled with numba.
+
+Members are planar rigid bodies in the fixed frame: centre (x, y) and rotation theta (counter-clockwise
+positive, absolute). For a pair of base radii r_b1 (sun or ring) and r_b2 (planet) with d = c_2 - c_1,
+D = |d|, phi = atan2(d_y, d_x):
+
+- external (sun-planet), R = r_b1 + r_b2:
+  ``delta = r_b1 theta_1 + r_b2 theta_2 - R phi - R inv(alpha_w)``,
+- internal (ring-planet), R = r_b1 - r_b2:
+  ``delta = r_b2 theta_2 - r_b1 theta_1 + R phi + R inv(alpha_w)``,
+
+with the operating pressure angle ``alpha_w = arccos(R / D)`` and ``inv(a) = tan a - a``: the signed
+approach of the two flanks along the line of action (docs/design-notes.md, "Planetary stages"), up to a
+constant fixed by the assembly. Both are unchanged by a rigid rotation of the pair, and by member 2
+rolling around member 1. The gradient of delta is +-r_b on the rotations, ``+n`` on the centre of member 1
+and ``-n`` on that of member 2, with the unit line of action ``n = sin(a) e + cos(a) e_perp`` (external)
+or its negative (internal), e = d / D, e_perp = e turned by +90 deg (because d(R inv(alpha_w))/dD =
+sin(alpha_w) and R / D = cos(alpha_w)). A normal force F does the virtual work F d(delta): the generalised
+forces are -F d(delta)/dq, the force on member 2 is +F n. Linearised about the assembly this is Lin &
+Parker's (1999) projection of the centres' motion on the line of action.
+
+One flank's geometry is used for both flanks (the back-flank contact of a reversing load uses the same
+line of action), as in the lateral parallel mesh.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["involute", "pair_deflection", "pair_deflection_rate", "operating_pressure_angle_rad"]
+
+
+@njit(cache=True)
+def involute(alpha_rad: float) -> float:
+    """inv(a) = tan a - a."""
+    return math.tan(alpha_rad) - alpha_rad
+
+
+@njit(cache=True)
+def operating_pressure_angle_rad(
+    centre_distance_m: float, r_b1_m: float, r_b2_m: float, internal: bool
+) -> float:
+    """arccos(R / D), R = r_b1 + r_b2 (external) or r_b1 - r_b2 (internal); nan if D <= R."""
+    R = r_b1_m - r_b2_m if internal else r_b1_m + r_b2_m
+    if centre_distance_m <= R:
+        return math.nan
+    return math.acos(R / centre_distance_m)
+
+
+@njit(cache=True)
+def pair_deflection(q: np.ndarray, r_b1_m: float, r_b2_m: float, internal: bool, phi_ref_rad: float) -> tuple:
+    """(delta_m, n_x, n_y, phi_rad, alpha_w_rad) of the pair ``q = [x1, y1, theta1, x2, y2, theta2]``;
+    ``n`` is the unit line of action along which the force on member 2 acts when delta > 0 (its
+    gradient: d(delta)/d(c_2) = -n, d(delta)/d(c_1) = +n). ``phi_ref_rad`` is the nominal, continuous
+    angle of the line of centres (the carrier angle plus the planet's position angle): phi is taken
+    within pi of it, so delta does not jump by 2 pi R when atan2 wraps over many carrier revolutions."""
+    dx, dy = q[3] - q[0], q[4] - q[1]
+    D = math.hypot(dx, dy)
+    phi = math.atan2(dy, dx)
+    phi += 2.0 * math.pi * math.floor((phi_ref_rad - phi) / (2.0 * math.pi) + 0.5)
+    alpha = operating_pressure_angle_rad(D, r_b1_m, r_b2_m, internal)
+    ex, ey = dx / D, dy / D
+    sa, ca = math.sin(alpha), math.cos(alpha)
+    # line of action: sin(a) e + cos(a) e_perp, e_perp = (-ey, ex)
+    lx, ly = sa * ex - ca * ey, sa * ey + ca * ex
+    if internal:
+        R = r_b1_m - r_b2_m
+        delta = r_b2_m * q[5] - r_b1_m * q[2] + R * phi + R * involute(alpha)
+        return delta, -lx, -ly, phi, alpha
+    R = r_b1_m + r_b2_m
+    delta = r_b1_m * q[2] + r_b2_m * q[5] - R * phi - R * involute(alpha)
+    return delta, lx, ly, phi, alpha
+
+
+@njit(cache=True)
+def pair_deflection_rate(
+    q: np.ndarray, q_t: np.ndarray, r_b1_m: float, r_b2_m: float, internal: bool
+) -> float:
+    """d(delta)/dt = grad(delta) . q_t (the gradient: +-r_b on the rotations, +n and -n on the centres)."""
+    _, nx, ny, _, _ = pair_deflection(q, r_b1_m, r_b2_m, internal, 0.0)  # n does not depend on phi_ref
+    rot = -r_b1_m * q_t[2] + r_b2_m * q_t[5] if internal else r_b1_m * q_t[2] + r_b2_m * q_t[5]
+    return rot + nx * (q_t[0] - q_t[3]) + ny * (q_t[1] - q_t[4])
