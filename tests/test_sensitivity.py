@@ -435,3 +435,45 @@ def _png_size(path):
     head = path.read_bytes()[:24]
     assert head[:8] == b"\x89PNG\r\n\x1a\n"
     return struct.unpack(">II", head[16:24])
+
+
+@pytest.mark.parametrize(
+    "option, message",
+    [
+        (["--samples", "-1"], "--samples = -1: must be a whole number >= 2"),
+        (["--t-end", "-1"], "--t-end = -1: must be a finite number > 0"),
+        (["--t-end", "nan"], "--t-end = nan: must be a finite number > 0"),
+        (["--workers", "0"], "--workers = 0: must be a whole number >= 1"),
+        (["--seed", "-3"], "--seed = -3: must be a whole number >= 0"),
+    ],
+)
+def test_numeric_options_are_refused_as_typed(tmp_path, capsys, option, message):
+    from gearbody.cli import main
+
+    args = [
+        "sensitivity",
+        "one-stage",
+        "--key",
+        "design.mesh.damping_Ns_per_m=3000:12000",
+        "--feature",
+        "kd_max",
+    ]
+    assert main([*args, *option, "--out", str(tmp_path / "s"), "--quiet"]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "s").exists()
+
+
+def test_an_out_that_is_a_file_is_refused_before_anything_runs(tmp_path, capsys):
+    from gearbody.cli import main
+
+    (tmp_path / "f").write_text("x")
+    args = [
+        "sensitivity",
+        "one-stage",
+        "--key",
+        "design.mesh.damping_Ns_per_m=3000:12000",
+        "--feature",
+        "kd_max",
+    ]
+    assert main([*args, "--out", str(tmp_path / "f"), "--quiet"]) == 2
+    assert "is a file, not a folder" in capsys.readouterr().err

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_OK, add_out, add_set, scenario_overrides, usage_error
+from .common import EXIT_OK, add_out, add_set, check_out, number, scenario_overrides, usage_error
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -48,18 +48,29 @@ def register(sub) -> argparse.ArgumentParser:
     se.add_argument("--method", choices=("morris", "sobol"), default="morris", help="default morris")
     se.add_argument(
         "--samples",
-        type=int,
+        type=number(whole=True, ge=2),
         default=8,
         metavar="N",
         help="Morris: trajectories (default 8); Sobol: base sample, a power of 2",
     )
-    se.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the sample (default 0)")
-    se.add_argument("--levels", type=int, default=4, metavar="P", help="Morris grid levels, even (default 4)")
+    se.add_argument(
+        "--seed", type=number(whole=True, ge=0), default=0, metavar="S", help="seed of the sample (default 0)"
+    )
+    se.add_argument(
+        "--levels",
+        type=number(whole=True, ge=2),
+        default=4,
+        metavar="P",
+        help="Morris grid levels, even (default 4)",
+    )
     se.add_argument("--no-second-order", action="store_true", help="Sobol: no S2 (D + 2 runs per sample)")
     add_set(se, "fixed override of every run (as for run)")
-    se.add_argument("--t-end", type=float, metavar="SECONDS", help="simulated time of every run")
+    se.add_argument("--t-end", type=number(gt=0), metavar="SECONDS", help="simulated time of every run")
     se.add_argument(
-        "--workers", type=int, metavar="N", help="local processes (default: all cores; 1: serial)"
+        "--workers",
+        type=number(whole=True, ge=1),
+        metavar="N",
+        help="local processes (default: all cores; 1: serial)",
     )
     se.add_argument(
         "--scheduler",
@@ -84,6 +95,7 @@ def execute(args) -> int:
     from gearbody.studies import SweepSpecError
     from gearbody.studies.sensitivity import sensitivity
 
+    check_out(args.out)
     try:
         res = sensitivity(
             args.scene,
