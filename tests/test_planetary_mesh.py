@@ -106,3 +106,56 @@ def test_a_ring_fixed_stage_turning_by_the_willis_kinematics_keeps_every_mesh_de
         if ref is None:
             ref = out
         np.testing.assert_allclose(out, ref, atol=1e-12)
+
+
+def _constant_mesh(z1: int, z2: int, r1: float, r2: float, k: float = 5e8, c: float = 0.0) -> np.ndarray:
+    from gearbody.physics.mesh import pack_mesh_parameters
+
+    return pack_mesh_parameters(
+        r1_m=r1, r2_m=r2, z1=z1, z2=z2, stiffness_single_N_per_m=k, stiffness_double_N_per_m=k,
+        contact_ratio=1.6, damping_Ns_per_m=c, backlash_m=0.0, friction_coefficient=0.0,
+        pitch_point_phase=0.5, pressure_angle_rad=ALPHA0, error_a=0.0, error_depths_m=np.zeros(z1),
+    )  # fmt: skip
+
+
+def test_planet_forces_are_minus_the_gradient_of_the_mesh_and_bearing_energy():
+    """Constant stiffness, no backlash, no damping: the forces derive from V = k_s d_s^2 / 2 + k_r d_r^2 / 2
+    + k_b |e|^2 / 2, so the whole stage is conservative (every sign and arm of the 12 forces checked)."""
+    from gearbody.physics import planetary_mesh as pm
+
+    k_s, k_r, k_b = 5e8, 6e8, 1e8
+    P_s, P_r = _constant_mesh(Z_S, Z_P, RB_S, RB_P, k_s), _constant_mesh(Z_R, Z_P, RB_R, RB_P, k_r)
+    G = np.zeros(pm.G_SIZE)
+    G[[pm.G_RB_SUN, pm.G_RB_PLANET, pm.G_RB_RING, pm.G_CARRIER_RADIUS, pm.G_PSI]] = (
+        RB_S,
+        RB_P,
+        RB_R,
+        R_S + R_P,
+        2.1,
+    )
+    G[pm.G_BEARING_K] = k_b
+    rng = np.random.default_rng(4)
+    theta_c = 5.3
+    r_c = R_S + R_P
+    planet = [r_c * math.cos(theta_c + 2.1), r_c * math.sin(theta_c + 2.1), -0.7]
+    q = np.array([0, 0, 1.1, 0, 0, 0.2, 0, 0, theta_c, *planet])
+    q = q + rng.normal(0.0, 2e-5, 12)  # a few um and urad off the assembly everywhere
+    G[pm.G_DELTA0_SUN] = (
+        pm.pair_deflection(q[[0, 1, 2, 9, 10, 11]], RB_S, RB_P, False, theta_c + 2.1)[0] - 3e-6
+    )
+    G[pm.G_DELTA0_RING] = (
+        pm.pair_deflection(q[[3, 4, 5, 9, 10, 11]], RB_R, RB_P, True, theta_c + 2.1)[0] + 2e-6
+    )
+
+    def energy(x):
+        phi_ref = x[8] + 2.1
+        d_s = pm.pair_deflection(x[[0, 1, 2, 9, 10, 11]], RB_S, RB_P, False, phi_ref)[0] - G[pm.G_DELTA0_SUN]
+        d_r = pm.pair_deflection(x[[3, 4, 5, 9, 10, 11]], RB_R, RB_P, True, phi_ref)[0] - G[pm.G_DELTA0_RING]
+        e = x[9:11] - (x[6:8] + r_c * np.array([math.cos(phi_ref), math.sin(phi_ref)]))
+        return 0.5 * k_s * d_s**2 + 0.5 * k_r * d_r**2 + 0.5 * k_b * float(e @ e)
+
+    f, F_s, F_r = pm.planet_forces(q, np.zeros(12), G, P_s, P_r)
+    assert F_s == pytest.approx(3e-6 * k_s, rel=1e-3) and F_r == pytest.approx(-2e-6 * k_r, rel=1e-3)
+    h = 1e-9
+    grad = np.array([(energy(q + h * e) - energy(q - h * e)) / (2 * h) for e in np.eye(12)])
+    np.testing.assert_allclose(f, -grad, rtol=1e-5, atol=1e-3)

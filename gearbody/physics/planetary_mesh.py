@@ -31,7 +31,16 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["involute", "pair_deflection", "pair_deflection_rate", "operating_pressure_angle_rad"]
+from .mesh import mesh_contact
+
+__all__ = [
+    "G_SIZE",
+    "involute",
+    "operating_pressure_angle_rad",
+    "pair_deflection",
+    "pair_deflection_rate",
+    "planet_forces",
+]
 
 
 @njit(cache=True)
@@ -84,3 +93,67 @@ def pair_deflection_rate(
     _, nx, ny, _, _ = pair_deflection(q, r_b1_m, r_b2_m, internal, 0.0)  # n does not depend on phi_ref
     rot = -r_b1_m * q_t[2] + r_b2_m * q_t[5] if internal else r_b1_m * q_t[2] + r_b2_m * q_t[5]
     return rot + nx * (q_t[0] - q_t[3]) + ny * (q_t[1] - q_t[4])
+
+
+# Layout of a planet's geometry array (planet_forces): base radii, carrier radius, position angle, planet
+# bearing, the mesh-law angle offsets and the deflections of the nominal assembly.
+G_RB_SUN, G_RB_PLANET, G_RB_RING, G_CARRIER_RADIUS, G_PSI = 0, 1, 2, 3, 4
+G_BEARING_K, G_BEARING_C, G_ANGLE_SUN, G_ANGLE_RING, G_DELTA0_SUN, G_DELTA0_RING = 5, 6, 7, 8, 9, 10
+G_SIZE = 11
+
+
+@njit(cache=True)
+def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarray, P_ring: np.ndarray):
+    """Generalised forces (12) of one planet's sun mesh, ring mesh and bearing on the carrier, and the two
+    normal mesh forces (N). ``q``, ``q_t``: absolute [x, y, theta] of sun, ring, carrier, planet (m, rad).
+
+    The meshes are :func:`gearbody.physics.mesh.mesh_contact` on the exact deflection of
+    :func:`pair_deflection` (sun mesh: sun = member 1, z1 = z_sun in ``P_sun``; ring mesh: ring = member
+    1, z1 = z_ring in ``P_ring``), the law's angle being member 1's rotation relative to the line of
+    centres plus ``G[G_ANGLE_*]``; forces -F grad(delta). The planet bearing is an isotropic spring-damper
+    between the planet centre and its point on the carrier, c_c + r_c (cos, sin)(theta_c + psi), its
+    reaction acting on the carrier at that point. Friction is not modelled here yet."""
+    f = np.zeros(12)
+    phi_ref = q[8] + G[G_PSI]
+    rbs, rbp, rbr = G[G_RB_SUN], G[G_RB_PLANET], G[G_RB_RING]
+    pair = np.empty(6)
+    pair_t = np.empty(6)
+    # sun mesh: sun (0..2) and planet (9..11)
+    for k in range(3):
+        pair[k], pair[3 + k] = q[k], q[9 + k]
+        pair_t[k], pair_t[3 + k] = q_t[k], q_t[9 + k]
+    d, nx, ny, phi, _ = pair_deflection(pair, rbs, rbp, False, phi_ref)
+    rate = pair_deflection_rate(pair, pair_t, rbs, rbp, False)
+    F_sun = mesh_contact(q[2] - phi + G[G_ANGLE_SUN], d - G[G_DELTA0_SUN], rate, P_sun)[0]
+    f[0] -= F_sun * nx
+    f[1] -= F_sun * ny
+    f[2] -= F_sun * rbs
+    f[9] += F_sun * nx
+    f[10] += F_sun * ny
+    f[11] -= F_sun * rbp
+    # ring mesh: ring (3..5) and planet
+    for k in range(3):
+        pair[k], pair_t[k] = q[3 + k], q_t[3 + k]
+    d, nx, ny, phi, _ = pair_deflection(pair, rbr, rbp, True, phi_ref)
+    rate = pair_deflection_rate(pair, pair_t, rbr, rbp, True)
+    F_ring = mesh_contact(q[5] - phi + G[G_ANGLE_RING], d - G[G_DELTA0_RING], rate, P_ring)[0]
+    f[3] -= F_ring * nx
+    f[4] -= F_ring * ny
+    f[5] += F_ring * rbr
+    f[9] += F_ring * nx
+    f[10] += F_ring * ny
+    f[11] -= F_ring * rbp
+    # planet bearing on the carrier
+    rc = G[G_CARRIER_RADIUS]
+    c, s = math.cos(phi_ref), math.sin(phi_ref)
+    ex, ey = q[9] - (q[6] + rc * c), q[10] - (q[7] + rc * s)
+    vx = q_t[9] - (q_t[6] - rc * s * q_t[8])
+    vy = q_t[10] - (q_t[7] + rc * c * q_t[8])
+    Fx = -G[G_BEARING_K] * ex - G[G_BEARING_C] * vx  # on the planet
+    Fy = -G[G_BEARING_K] * ey - G[G_BEARING_C] * vy
+    f[9] += Fx
+    f[10] += Fy
+    f[6] -= Fx
+    f[7] -= Fy
+    f[8] += rc * (s * Fx - c * Fy)
+    return f, F_sun, F_ring
