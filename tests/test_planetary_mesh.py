@@ -39,14 +39,16 @@ def test_the_gradient_is_plus_minus_the_base_radii_and_the_line_of_action(intern
             pair_deflection(q + e, rb1, RB_P, internal, 0.7)[0]
             - pair_deflection(q - e, rb1, RB_P, internal, 0.7)[0]
         ) / (2 * h)
-    expected = np.array([nx, ny, -rb1 if internal else rb1, -nx, -ny, RB_P])
+    expected = np.array([nx, ny, rb1, -nx, -ny, -RB_P if internal else RB_P])
     np.testing.assert_allclose(grad, expected, rtol=1e-6, atol=1e-8)
     # the rate is the gradient times the velocities
     qt = np.array([0.3, -0.1, 12.0, 0.2, 0.4, -7.0])
     assert pair_deflection_rate(q, qt, rb1, RB_P, internal) == pytest.approx(float(grad @ qt), rel=1e-6)
-    # the line of action makes the operating pressure angle with the normal of the line of centres
+    # the line of action makes the operating pressure angle with the normal of the line of centres, on
+    # the sun mesh leaning towards the planet, on the ring mesh away from it (mirrored lines of action)
     e = np.array([math.cos(phi), math.sin(phi)])
-    assert abs(float(np.dot([nx, ny], e))) == pytest.approx(math.sin(alpha))
+    assert float(np.dot([nx, ny], e)) == pytest.approx(-math.sin(alpha) if internal else math.sin(alpha))
+    assert float(np.dot([nx, ny], [-e[1], e[0]])) == pytest.approx(math.cos(alpha))
 
 
 @pytest.mark.parametrize("internal", [False, True])

@@ -8,17 +8,21 @@ D = |d|, phi = atan2(d_y, d_x):
 - external (sun-planet), R = r_b1 + r_b2:
   ``delta = r_b1 theta_1 + r_b2 theta_2 - R phi - R inv(alpha_w)``,
 - internal (ring-planet), R = r_b1 - r_b2:
-  ``delta = r_b2 theta_2 - r_b1 theta_1 + R phi + R inv(alpha_w)``,
+  ``delta = r_b1 theta_1 - r_b2 theta_2 - R phi + R inv(alpha_w)``,
 
 with the operating pressure angle ``alpha_w = arccos(R / D)`` and ``inv(a) = tan a - a``: the signed
 approach of the two flanks along the line of action (docs/design-notes.md, "Planetary stages"), up to a
-constant fixed by the assembly. Both are unchanged by a rigid rotation of the pair, and by member 2
-rolling around member 1. The gradient of delta is +-r_b on the rotations, ``+n`` on the centre of member 1
-and ``-n`` on that of member 2, with the unit line of action ``n = sin(a) e + cos(a) e_perp`` (external)
-or its negative (internal), e = d / D, e_perp = e turned by +90 deg (because d(R inv(alpha_w))/dD =
-sin(alpha_w) and R / D = cos(alpha_w)). A normal force F does the virtual work F d(delta): the generalised
-forces are -F d(delta)/dq, the force on member 2 is +F n. Linearised about the assembly this is Lin &
-Parker's (1999) projection of the centres' motion on the line of action.
+constant fixed by the assembly. The flanks are those loaded when the sun drives counter-clockwise
+(positive sun torque): on the sun mesh the sun's leading flank, on the ring mesh the planet's flank
+facing the ring on the other side (Lin & Parker's psi_sn = psi_n - alpha_s and psi_rn = psi_n + alpha_r:
+the two lines of action are mirrored about the planet's radius). Both are unchanged by a rigid rotation
+of the pair, and by member 2 rolling around member 1. The gradient of delta is +-r_b on the rotations,
+``+n`` on the centre of member 1 and ``-n`` on that of member 2, with the unit line of action ``n =
+sin(a) e + cos(a) e_perp`` (external) or ``n = -sin(a) e + cos(a) e_perp`` (internal), e = d / D, e_perp
+= e turned by +90 deg (because d(R inv(alpha_w))/dD = sin(alpha_w) and R / D = cos(alpha_w)). A normal
+force F does the virtual work F d(delta): the generalised forces are -F d(delta)/dq, the force on member
+2 is +F n. Linearised about the assembly this is Lin & Parker's (1999) projection of the centres' motion
+on the line of action.
 
 One flank's geometry is used for both flanks (the back-flank contact of a reversing load uses the same
 line of action), as in the lateral parallel mesh.
@@ -78,8 +82,8 @@ def pair_deflection(q: np.ndarray, r_b1_m: float, r_b2_m: float, internal: bool,
     lx, ly = sa * ex - ca * ey, sa * ey + ca * ex
     if internal:
         R = r_b1_m - r_b2_m
-        delta = r_b2_m * q[5] - r_b1_m * q[2] + R * phi + R * involute(alpha)
-        return delta, -lx, -ly, phi, alpha
+        delta = r_b1_m * q[2] - r_b2_m * q[5] - R * phi + R * involute(alpha)
+        return delta, -sa * ex - ca * ey, -sa * ey + ca * ex, phi, alpha
     R = r_b1_m + r_b2_m
     delta = r_b1_m * q[2] + r_b2_m * q[5] - R * phi - R * involute(alpha)
     return delta, lx, ly, phi, alpha
@@ -89,9 +93,10 @@ def pair_deflection(q: np.ndarray, r_b1_m: float, r_b2_m: float, internal: bool,
 def pair_deflection_rate(
     q: np.ndarray, q_t: np.ndarray, r_b1_m: float, r_b2_m: float, internal: bool
 ) -> float:
-    """d(delta)/dt = grad(delta) . q_t (the gradient: +-r_b on the rotations, +n and -n on the centres)."""
+    """d(delta)/dt = grad(delta) . q_t (the gradient: r_b1 and +-r_b2 on the rotations, +n and -n on the
+    centres)."""
     _, nx, ny, _, _ = pair_deflection(q, r_b1_m, r_b2_m, internal, 0.0)  # n does not depend on phi_ref
-    rot = -r_b1_m * q_t[2] + r_b2_m * q_t[5] if internal else r_b1_m * q_t[2] + r_b2_m * q_t[5]
+    rot = r_b1_m * q_t[2] - r_b2_m * q_t[5] if internal else r_b1_m * q_t[2] + r_b2_m * q_t[5]
     return rot + nx * (q_t[0] - q_t[3]) + ny * (q_t[1] - q_t[4])
 
 
@@ -139,10 +144,10 @@ def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarr
     F_ring = mesh_contact(q[5] - phi + G[G_ANGLE_RING], d - G[G_DELTA0_RING], rate, P_ring)[0]
     f[3] -= F_ring * nx
     f[4] -= F_ring * ny
-    f[5] += F_ring * rbr
+    f[5] -= F_ring * rbr
     f[9] += F_ring * nx
     f[10] += F_ring * ny
-    f[11] -= F_ring * rbp
+    f[11] += F_ring * rbp
     # planet bearing on the carrier
     rc = G[G_CARRIER_RADIUS]
     c, s = math.cos(phi_ref), math.sin(phi_ref)
