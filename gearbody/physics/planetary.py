@@ -69,7 +69,7 @@ class PlanetaryGeometryError(GearGeometryError):
 
 
 def _fmt(value) -> str:
-    return f"{value:.6g}" if isinstance(value, float) else repr(value)
+    return f"{value:.6g}" if isinstance(value, float) and not value.is_integer() else repr(value)
 
 
 def _error(name: str, value, reason: str, allowed: str) -> PlanetaryGeometryError:
