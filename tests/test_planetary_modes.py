@@ -96,6 +96,10 @@ def test_equally_spaced_structure_6_rotational_6_translational_pairs_3_planet_fr
     modes = natural_modes(lin_parker_1999_parameters(n))
     _check_equally_spaced_structure(modes, n)
     assert modes.of_kind("rotational")[0].frequency_hz == pytest.approx(0.0, abs=1e-3)  # rigid body
+    table = modes.table()
+    assert [r["frequency_hz"] for r in table] == sorted(r["frequency_hz"] for r in table)
+    assert sum(r["multiplicity"] for r in table) == 3 * (n + 3)
+    assert {r["kind"] for r in table} == ({"rotational", "translational"} | ({"planet"} if n > 3 else set()))
 
 
 @settings(max_examples=25, deadline=None)
@@ -493,16 +497,41 @@ def test_mesh_delays_equal_a_tooth_by_tooth_timing_in_the_carrier_frame(sun_ccw)
         assert min(abs(d_s - d_r), 1 - abs(d_s - d_r)) < 1e-9  # both meshes of a planet shift alike
 
 
+@pytest.mark.parametrize("sun_flank_sign", [-1.0, 1.0])
 @pytest.mark.parametrize("z_planet", [25, 26, 27, 30])
-def test_ring_sun_offset_equals_flank_passages_of_a_half_pitch_tooth(z_planet):
-    # planet frame: sun pitch point at angle pi, ring pitch point at 0; sun loads the clockwise flanks,
-    # the ring the counterclockwise ones (parallel tangential forces at the ends of a diameter)
+def test_ring_sun_offset_equals_flank_passages_of_a_half_pitch_tooth(z_planet, sun_flank_sign):
+    # planet frame: sun pitch point at angle pi, ring pitch point at 0. Sun and ring push the planet with
+    # parallel tangential forces at the ends of a diameter, so they load opposite flanks: the sun the
+    # clockwise flanks (sign -1) and the ring the counterclockwise ones, or the reverse under reversed load
     half_tooth = math.pi / (2 * z_planet)  # tooth thickness p/2 at the pitch circle
     omega = 1.0
     period = 2 * math.pi / z_planet
-    t_sun = _first_crossing_time(0.2 - half_tooth, z_planet, omega, math.pi, period)
-    t_ring = _first_crossing_time(0.2 + half_tooth, z_planet, omega, 0.0, period)
+    t_sun = _first_crossing_time(0.2 + sun_flank_sign * half_tooth, z_planet, omega, math.pi, period)
+    t_ring = _first_crossing_time(0.2 - sun_flank_sign * half_tooth, z_planet, omega, 0.0, period)
     offset = ((t_ring - t_sun) / period) % 1.0
     offset = 0.0 if min(offset, 1 - offset) < 1e-9 else offset
     g = PlanetaryGeometry(z_sun=20, z_planet=z_planet, z_ring=20 + 2 * z_planet, n_planets=1, module_m=0.002)
     assert planet_mesh_phases(g).ring_sun == pytest.approx(offset, abs=1e-9)
+
+
+# ---------------------------------------------------------------------------------------- the doc
+def test_docs_table_holds_the_published_and_the_computed_frequencies():
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "planetary.md").read_text()
+    rows = [line for line in text.splitlines() if line.startswith("| ") and " / " in line]
+    kind = None
+    seen = {n: {k: [] for k in PUBLISHED[n]} for n in PUBLISHED}
+    for line in rows:
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        kind = cells[0].split(" ")[0] or kind
+        for n, cell in zip((3, 4, 5), cells[1:], strict=True):
+            if " / " in cell:
+                pub, comp = (float(x) for x in cell.replace("(x2)", "").split(" / "))
+                seen[n][kind].append((pub, comp))
+    for n in PUBLISHED:
+        modes = natural_modes(lin_parker_1999_parameters(n))
+        for k, published in PUBLISHED[n].items():
+            assert [p for p, _ in seen[n][k]] == published, (n, k)
+            computed = [round(g.frequency_hz, 2) for g in modes.of_kind(k)]
+            assert [c for _, c in seen[n][k]] == pytest.approx(computed, abs=0.006), (n, k)
