@@ -50,6 +50,22 @@ def test_hand_computed_example_numbers():
     assert s.sun_relative_hz == 25.0
 
 
+def test_fault_frequencies_are_mesh_frequency_over_teeth():
+    """A second route: a member turns f_m / Z relative to the carrier, so f_sf = N f_m / Z_s,
+    f_pf = f_m / Z_p, f_rf = N f_m / Z_r, for the example and for a stage with a turning ring."""
+    turning_ring = PlanetarySources(
+        20, 31, 82, 4, carrier_hz=3.0, sun_hz=3.0 + 82 * 4.5 / 20, ring_hz=-1.5, planet_hz=3.0 - 82 * 4.5 / 31
+    )
+    for s in (example(), turning_ring):
+        f_m = s.mesh_hz
+        assert s.sun_fault_hz == pytest.approx(s.n_planets * f_m / s.z_sun, rel=1e-13)
+        assert s.planet_fault_hz == pytest.approx(f_m / s.z_planet, rel=1e-13)
+        assert s.ring_fault_hz == pytest.approx(s.n_planets * f_m / s.z_ring, rel=1e-13)
+    assert turning_ring.mesh_hz == pytest.approx(82 * 4.5) and turning_ring.planet_pass_hz == pytest.approx(
+        18.0
+    )
+
+
 def test_catalogue_names_the_example_lines():
     lines = planetary_lines(example(), f_max_hz=900.0, harmonics=2, sidebands=6, fault_orders=2)
     assert all(isinstance(line, PlanetaryLine) for line in lines)
@@ -224,6 +240,31 @@ def test_labelled_peaks_of_the_sensor_signal_name_the_planetary_lines():
     assert "f_m + f_c" in peaks_table(peaks)
 
 
+def test_example_stage_sensor_spectrum_labelled_in_hertz():
+    """The stated example at its own speeds (f_c = 175/34 Hz, f_m = 416.9 Hz), planets in phase
+    (Z_r = 81 = 27 * 3): the peaks are the mesh harmonic and its sidebands at +-3 f_c, +-6 f_c, all
+    lines the catalogue marks as surviving equal spacing."""
+    s = example()
+    n_samples = SAMPLES_PER_REV * REVOLUTIONS
+    fs_hz = SAMPLES_PER_REV * s.carrier_hz
+    t = np.arange(n_samples) / fs_hz
+    psi = 2 * np.pi * s.carrier_hz * t[None, :] + 2 * np.pi * np.arange(3)[:, None] / 3
+    forces = 100.0 * np.cos(2 * np.pi * s.mesh_hz * t[None, :] + 81 * (psi - psi[:1]))  # phase Z_r psi_n
+    y = ring_sensor_signal(t, psi, forces, 0.3, HannPassWindow(WIDE_RAD)).signal_N
+    spectrum = amplitude_spectrum(y, fs_hz, window="boxcar")
+    lines = planetary_lines(s, 500.0, harmonics=1)
+    peaks = label_peaks(spectrum, lines, min_prominence_db=40.0, f_max_hz=500.0)
+    top = max(p.amplitude for p in peaks)
+    peaks = [p for p in peaks if p.amplitude > 1e-4 * top]  # not the far branch's 1e-16 N lines
+    labels = [p.label for p in peaks]
+    assert {"1 f_m", "f_m + 3 f_c", "f_m - 3 f_c", "f_m + 6 f_c", "f_m - 6 f_c"} <= set(labels)
+    by_label = {line.label: line for line in lines}
+    for p in peaks:
+        assert all(by_label[label].survives_equal_spacing for label in p.labels), p.label
+    assert max(peaks, key=lambda p: p.amplitude).label == "1 f_m"
+    assert max(peaks, key=lambda p: p.amplitude).frequency_hz == pytest.approx(14175 / 34, rel=1e-12)
+
+
 # --- the window and the sensor's sum, by hand ----------------------------------------------------------
 
 
@@ -251,6 +292,14 @@ def test_ring_sensor_sum_and_projection_by_hand():
     np.testing.assert_allclose(plain.weights, 0.5)
     projected = ring_sensor_signal(t, psi, forces, np.pi / 4, HannPassWindow(np.pi), np.pi / 2)
     np.testing.assert_allclose(projected.signal_N, [3 / math.sqrt(2)] * 2)
+    # a custom window sees the angles wrapped to [-pi, pi): planets 10 turns on give the same signal
+    seen = []
+    window = HannPassWindow(np.pi)
+    custom = ring_sensor_signal(
+        t, psi + 20 * np.pi, forces, np.pi / 4, lambda phi: seen.append(phi) or window(phi)
+    )
+    np.testing.assert_allclose(custom.signal_N, plain.signal_N)
+    np.testing.assert_allclose(seen[0], [[-np.pi / 4] * 2, [np.pi / 4] * 2])
 
 
 # --- McFadden and Smith's rule and Parker's rule -------------------------------------------------------
@@ -422,3 +471,21 @@ def test_bad_sensor_input_is_named():
         ring_sensor_signal(t, psi, psi, 0.0, lambda phi: np.ones(4))
     with pytest.raises(ValueError, match=r"force_direction_offset_rad must be a finite angle"):
         ring_sensor_signal(t, psi, psi, 0.0, window, math.nan)
+
+
+def test_the_docs_quote_the_numbers_the_code_computes():
+    """docs/planetary-lines.md gives the example's lines and the two phasing spectra; they must stay what
+    the code computes."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "planetary-lines.md").read_text()
+    s = example()
+    for line in planetary_lines(s, 450.0, harmonics=1, sidebands=6, member_orders=1, fault_orders=2):
+        if line.label in text:
+            assert f"| {line.label} | {line.family} | {line.frequency_hz:.4f} |" in text, line.label
+    in_phase = sensor_spectrum(81, 3, HannPassWindow(WIDE_RAD))
+    sequential = sensor_spectrum(80, 3, HannPassWindow(WIDE_RAD))
+    for value in (in_phase[81], in_phase[84], in_phase[87], sequential[81], sequential[78], sequential[84]):
+        assert f"{value:.4f}" in text
+    f_c = 25 * 22 / 102  # the sequential stage, sun at 25 Hz, ring fixed
+    assert f"f_c = {f_c:.4f} Hz, f_m = {80 * f_c:.4f} Hz" in text and f"{81 * f_c:.4f} Hz" in text

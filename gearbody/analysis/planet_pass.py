@@ -114,8 +114,8 @@ def ring_sensor_signal(
             (n_planets, n_samples).
         planet_mesh_forces_N: F_n(t), each planet's mesh force [N], same shape.
         sensor_angle_rad: theta_s, the sensor's angle in the same frame [rad].
-        window: w(phi), e.g. :class:`HannPassWindow`; any callable mapping an angle array to weights
-            of the same shape.
+        window: w(phi), e.g. :class:`HannPassWindow`; any callable mapping an array of angles
+            phi = psi_n - theta_s, wrapped to [-pi, pi), to weights of the same shape.
         force_direction_offset_rad: None for the window alone; else delta, the angle of planet n's
             force direction minus psi_n, and the force is projected on the sensor axis (a radial
             sensor at theta_s): factor cos(psi_n + delta - theta_s). For the ring-planet mesh force on
@@ -139,7 +139,7 @@ def ring_sensor_signal(
         raise ValueError(f"sensor_angle_rad must be a finite angle [rad], got {sensor_angle_rad!r}")
     if not callable(window):
         raise ValueError(f"window must be callable (e.g. HannPassWindow), got {type(window).__name__}")
-    relative = psi - float(sensor_angle_rad)
+    relative = wrap_angle_rad(psi - float(sensor_angle_rad))
     weights = np.asarray(window(relative), dtype=float)
     if weights.shape != psi.shape or not np.all(np.isfinite(weights)):
         raise ValueError(f"window must return finite weights of shape {psi.shape}, got shape {weights.shape}")

@@ -24,9 +24,15 @@ turns with the ring, so with the usual fixed ring every line is an absolute freq
   equal to f_pp)
 - sidebands: k f_m +- n f_c' (the planets' transfer to the sensor varies at the carrier speed)
 
-Sources: McFadden & Smith (1985), Proc. IMechE 199(C1):65-70 (ring-fixed sensor, planet pass,
-sidebands); Inalpolat & Kahraman (2009), J. Sound Vib. 323:677-696 (the sun, planet and ring fault
-frequencies above, in their notation); /work/shared/design/REFERENCES.md, "Planetary stages". For
+The fault frequencies are also f_sf = N f_m / Z_s, f_pf = f_m / Z_p and f_rf = N f_m / Z_r (a member's
+speed relative to the carrier is f_m over its tooth number), the form of Feng & Zuo (2012), Mech. Syst.
+Signal Process. 34:165-178.
+
+Sources: McFadden & Smith (1985), Proc. IMechE 199(C1):65-70 (ring-fixed sensor, planet pass, carrier
+sidebands); Inalpolat & Kahraman (2009), J. Sound Vib. 323:677-696 (sidebands of a fixed sensor, the
+sun, planet and ring fault modulations); Feng & Zuo (2012); /work/shared/design/REFERENCES.md,
+"Planetary stages". The citations of the fault frequencies are from memory; the formulas themselves
+follow from the tooth counting above and are checked by the Willis identities in the tests. For
 equally spaced, identical planets McFadden and Smith's rule says which of these lines survive the sum
 over the planets (:attr:`PlanetaryLine.survives_equal_spacing`, :mod:`gearbody.analysis.planet_pass`).
 """
