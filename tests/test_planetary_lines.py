@@ -217,6 +217,26 @@ def test_sequential_phasing_makes_the_sidebands_asymmetric():
     assert a[81] > a[78]  # |W_1| > |W_2| for this window
 
 
+def test_three_mesh_harmonics_follow_the_rule_each():
+    """Forces with harmonics 1, 2, 3 (Z_r = 80, N = 3): harmonics 1 and 2 suppressed with their strongest
+    lines at q = +1 and q = -1, harmonic 3 (240 = 0 mod 3) present; nothing outside the rule's lines."""
+    n_samples = SAMPLES_PER_REV * REVOLUTIONS
+    t = np.arange(n_samples) / SAMPLES_PER_REV
+    psi = 2 * np.pi * t[None, :] + 2 * np.pi * np.arange(3)[:, None] / 3
+    forces = np.cos(80 * psi) + 0.5 * np.cos(160 * psi + 0.3) + 0.25 * np.cos(240 * psi - 1.0)
+    y = ring_sensor_signal(t, psi, forces, 0.3, HannPassWindow(WIDE_RAD)).signal_N
+    a = (2 * np.abs(np.fft.rfft(y)) / n_samples)[::REVOLUTIONS]
+    allowed = set()
+    for rule in surviving_lines(80, 3, 3, 40):  # bands of +-40 orders cover 74 .. 246
+        centre = 80 * rule.harmonic
+        band = {q: a[centre + q] for q in range(-6, 7)}
+        assert (band[0] > 1e-3) == rule.mesh_present
+        assert max(band, key=band.get) in rule.nearest_q
+        allowed |= {centre + q for q in rule.q}
+    outside = [a[order] for order in range(74, 247) if order not in allowed]
+    assert max(outside) < 1e-12
+
+
 def test_unequally_spaced_planets_break_the_cancellation():
     """The rule is a property of equal spacing: planets at 0, 110 and 250 degrees show every line."""
     a = sensor_spectrum(80, 3, HannPassWindow(np.pi), positions_rad=np.radians([0.0, 110.0, 250.0]))
