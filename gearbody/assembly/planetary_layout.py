@@ -1,0 +1,121 @@
+"""Layout of a planetary stage for the Exudyn builder (engine-free): sun, ring, carrier and N planets as
+planar members, their supports, the planets' positions and bearings on the carrier, and the packed mesh
+laws of the sun and ring meshes (issue 19, docs/design-notes.md "Planetary stages").
+
+The members' nominal assembly: sun, ring and carrier centred at the origin, planet n on the carrier
+circle at angle psi_n; every rotation 0. The deflections of that assembly (:func:`nominal_deflections_m`)
+are the zero of each mesh law, so the nominal assembly is unloaded.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..physics.planetary_mesh import (
+    G_ANGLE_RING,
+    G_ANGLE_SUN,
+    G_BEARING_C,
+    G_BEARING_K,
+    G_CARRIER_RADIUS,
+    G_DELTA0_RING,
+    G_DELTA0_SUN,
+    G_PSI,
+    G_RB_PLANET,
+    G_RB_RING,
+    G_RB_SUN,
+    G_SIZE,
+    pair_deflection,
+)
+
+__all__ = ["PlanetaryLayout", "PlanetaryMember", "nominal_deflections_m", "rigid_speeds_rad_s"]
+
+CENTRAL = ("sun", "ring", "carrier")
+
+
+@dataclass(frozen=True)
+class PlanetaryMember:
+    """A planar member: mass, inertia, an isotropic bearing (for a planet: its bearing on the carrier;
+    otherwise its support to the housing) and an optional torsional support to the housing."""
+
+    name: str
+    mass_kg: float
+    inertia_kg_m2: float
+    bearing_stiffness_N_per_m: float
+    bearing_damping_Ns_per_m: float = 0.0
+    torsion_stiffness_Nm_per_rad: float | None = None  # None: free to turn
+    torsion_damping_Nms_per_rad: float = 0.0
+
+
+@dataclass(frozen=True)
+class PlanetaryLayout:
+    """One planetary stage: members, geometry and the packed sun- and ring-mesh laws (z1 = z_sun and
+    z1 = z_ring, :func:`gearbody.physics.mesh.pack_mesh_parameters`)."""
+
+    sun: PlanetaryMember
+    ring: PlanetaryMember
+    carrier: PlanetaryMember
+    planet: PlanetaryMember
+    planet_angles_rad: tuple[float, ...]
+    carrier_radius_m: float
+    base_radius_sun_m: float
+    base_radius_planet_m: float
+    base_radius_ring_m: float
+    sun_mesh: np.ndarray = field(repr=False)
+    ring_mesh: np.ndarray = field(repr=False)
+    mesh_angle_offsets_rad: tuple[tuple[float, float], ...] = ()  # per planet (sun, ring); () = zeros
+
+    def __post_init__(self) -> None:
+        if not self.planet_angles_rad:
+            raise ValueError("a planetary stage needs at least one planet")
+        if self.mesh_angle_offsets_rad and len(self.mesh_angle_offsets_rad) != len(self.planet_angles_rad):
+            raise ValueError("mesh_angle_offsets_rad needs one (sun, ring) pair per planet")
+
+    @property
+    def members(self) -> tuple[PlanetaryMember, ...]:
+        return (self.sun, self.ring, self.carrier)
+
+    def planet_centre_m(self, n: int) -> tuple[float, float]:
+        psi = self.planet_angles_rad[n]
+        return self.carrier_radius_m * math.cos(psi), self.carrier_radius_m * math.sin(psi)
+
+    def geometry(self, n: int) -> np.ndarray:
+        """The geometry array of planet n for :func:`gearbody.physics.planetary_mesh.planet_forces`."""
+        G = np.zeros(G_SIZE)
+        G[G_RB_SUN], G[G_RB_PLANET], G[G_RB_RING] = (
+            self.base_radius_sun_m,
+            self.base_radius_planet_m,
+            self.base_radius_ring_m,
+        )
+        G[G_CARRIER_RADIUS], G[G_PSI] = self.carrier_radius_m, self.planet_angles_rad[n]
+        G[G_BEARING_K] = self.planet.bearing_stiffness_N_per_m
+        G[G_BEARING_C] = self.planet.bearing_damping_Ns_per_m
+        if self.mesh_angle_offsets_rad:
+            G[G_ANGLE_SUN], G[G_ANGLE_RING] = self.mesh_angle_offsets_rad[n]
+        G[G_DELTA0_SUN], G[G_DELTA0_RING] = nominal_deflections_m(self, n)
+        return G
+
+
+def nominal_deflections_m(layout: PlanetaryLayout, n: int) -> tuple[float, float]:
+    """(sun, ring) mesh deflections of planet n at the nominal assembly (every rotation 0)."""
+    x, y = layout.planet_centre_m(n)
+    psi = layout.planet_angles_rad[n]
+    planet = [x, y, 0.0]
+    d_s = pair_deflection(
+        np.array([0.0, 0.0, 0.0, *planet]), layout.base_radius_sun_m, layout.base_radius_planet_m, False, psi
+    )[0]
+    d_r = pair_deflection(
+        np.array([0.0, 0.0, 0.0, *planet]), layout.base_radius_ring_m, layout.base_radius_planet_m, True, psi
+    )[0]
+    return d_s, d_r
+
+
+def rigid_speeds_rad_s(layout: PlanetaryLayout, sun_rad_s: float, carrier_rad_s: float) -> dict[str, float]:
+    """Speeds of rigid rolling from the sun's and the carrier's (Willis, on base radii): the ring and
+    every planet's absolute spin."""
+    rbs, rbp, rbr = layout.base_radius_sun_m, layout.base_radius_planet_m, layout.base_radius_ring_m
+    planet = carrier_rad_s - rbs / rbp * (sun_rad_s - carrier_rad_s)
+    ring = carrier_rad_s + rbp / rbr * (planet - carrier_rad_s)
+    return {"sun": sun_rad_s, "carrier": carrier_rad_s, "ring": ring, "planet": planet}

@@ -1,0 +1,121 @@
+"""The planetary stage on Exudyn (gearbody.engine.planetary): static load sharing and reactions by hand,
+energy conservation of the free stage (every force a gradient, Exudyn's planar rigid bodies carrying the
+planets' centripetal motion), and rigid rolling without load."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gearbody.assembly.planetary_layout import PlanetaryLayout, PlanetaryMember, rigid_speeds_rad_s
+from gearbody.engine.planetary import build_planetary, planetary_mesh_forces, solve_planetary
+from gearbody.physics.mesh import pack_mesh_parameters
+from gearbody.physics.planetary_mesh import pair_deflection
+
+ALPHA0 = math.radians(20.0)
+MODULE = 0.004
+Z_S, Z_P, Z_R = 21, 30, 81
+R_S, R_P, R_R = (MODULE * z / 2 for z in (Z_S, Z_P, Z_R))
+RB_S, RB_P, RB_R = (r * math.cos(ALPHA0) for r in (R_S, R_P, R_R))
+K_MESH = 5e8
+
+
+def _mesh(z1, z2, r1, r2, damping=0.0):
+    return pack_mesh_parameters(
+        r1_m=r1, r2_m=r2, z1=z1, z2=z2, stiffness_single_N_per_m=K_MESH, stiffness_double_N_per_m=K_MESH,
+        contact_ratio=1.6, damping_Ns_per_m=damping, backlash_m=0.0, friction_coefficient=0.0,
+        pitch_point_phase=0.5, pressure_angle_rad=ALPHA0, error_a=0.0, error_depths_m=np.zeros(z1),
+    )  # fmt: skip
+
+
+def _layout(n_planets=3, *, damping=0.0, torsion=1e7):
+    c = damping
+    held = (
+        {"torsion_stiffness_Nm_per_rad": torsion, "torsion_damping_Nms_per_rad": 0.025 * c} if torsion else {}
+    )
+    return PlanetaryLayout(
+        sun=PlanetaryMember("sun", 0.5, 0.5 * 0.5 * R_S**2, 1e8, c),
+        ring=PlanetaryMember("ring", 3.0, 3.0 * R_R**2, 1e8, c, **held),
+        carrier=PlanetaryMember("carrier", 5.0, 0.6 * 5.0 * (R_S + R_P) ** 2, 1e8, c, **held),
+        planet=PlanetaryMember("planet", 0.8, 0.5 * 0.8 * R_P**2, 1e8, c),
+        planet_angles_rad=tuple(2 * math.pi * n / n_planets for n in range(n_planets)),
+        carrier_radius_m=R_S + R_P,
+        base_radius_sun_m=RB_S,
+        base_radius_planet_m=RB_P,
+        base_radius_ring_m=RB_R,
+        sun_mesh=_mesh(Z_S, Z_P, RB_S, RB_P, c),
+        ring_mesh=_mesh(Z_R, Z_P, RB_R, RB_P, c),
+    )
+
+
+def test_a_sun_torque_is_shared_equally_and_the_reactions_balance():
+    """Ring and carrier held by torsional supports: at rest every planet carries T / (N r_bs) on both
+    meshes; the ring reacts T r_br / r_bs and the carrier T (1 + r_br / r_bs)."""
+    T, n = 100.0, 3
+    system = build_planetary(_layout(n, damping=2000.0), torques_Nm={"sun": T})
+    states = solve_planetary(system, 0.1)
+    forces = planetary_mesh_forces(system, states)
+    for k in range(1, n + 1):
+        for mesh in ("sun", "ring"):
+            assert forces[f"planet_{k}_{mesh}_mesh_force_N"][-1] == pytest.approx(T / (n * RB_S), rel=1e-6)
+    assert -1e7 * states["ring_q"][-1, 2] == pytest.approx(T * RB_R / RB_S, rel=1e-6)
+    assert -1e7 * states["carrier_q"][-1, 2] == pytest.approx(-T * (1 + RB_R / RB_S), rel=1e-6)
+
+
+def _energy(system, states) -> np.ndarray:
+    """Kinetic + mesh + bearing energy of the undamped stage, computed here from the recorded states."""
+    lay = system.layout
+    E = np.zeros(len(states["time_s"]))
+    for name, member in (("sun", lay.sun), ("ring", lay.ring), ("carrier", lay.carrier)):
+        q, v = states[f"{name}_q"], states[f"{name}_v"]
+        E += 0.5 * member.mass_kg * (v[:, 0] ** 2 + v[:, 1] ** 2) + 0.5 * member.inertia_kg_m2 * v[:, 2] ** 2
+        E += 0.5 * member.bearing_stiffness_N_per_m * (q[:, 0] ** 2 + q[:, 1] ** 2)
+    for n, psi in enumerate(lay.planet_angles_rad):
+        G = lay.geometry(n)
+        q, v = states[f"planet_{n + 1}_q"], states[f"planet_{n + 1}_v"]
+        E += (
+            0.5 * lay.planet.mass_kg * (v[:, 0] ** 2 + v[:, 1] ** 2)
+            + 0.5 * lay.planet.inertia_kg_m2 * v[:, 2] ** 2
+        )
+        for i in range(len(E)):
+            s, r, c = states["sun_q"][i], states["ring_q"][i], states["carrier_q"][i]
+            phi_ref = c[2] + psi
+            d_s = pair_deflection(np.r_[s, q[i]], RB_S, RB_P, False, phi_ref)[0] - G[9]
+            d_r = pair_deflection(np.r_[r, q[i]], RB_R, RB_P, True, phi_ref)[0] - G[10]
+            point = c[:2] + lay.carrier_radius_m * np.array([math.cos(phi_ref), math.sin(phi_ref)])
+            e = q[i, :2] - point
+            E[i] += 0.5 * K_MESH * (d_s**2 + d_r**2) + 0.5 * lay.planet.bearing_stiffness_N_per_m * float(
+                e @ e
+            )
+    return E
+
+
+def test_the_free_undamped_stage_conserves_energy_while_its_planets_circle():
+    """No supports in torsion, no damping: started rigidly at 300 rad/s sun and 60 rad/s carrier, the
+    planets' centripetal load stretches their bearings and sets the stage vibrating; the total energy
+    stays constant (a sign or arm error in any of the forces, or a wrong reference, would break it)."""
+    lay = _layout(3, torsion=None)
+    system = build_planetary(lay, sun_speed_rad_s=300.0, carrier_speed_rad_s=60.0)
+    states = solve_planetary(system, 0.02, absolute_tolerance=1e-10)
+    E = _energy(system, states)
+    assert states["carrier_q"][-1, 2] == pytest.approx(60.0 * 0.02, rel=0.01)  # ~1.2 rad: planets moved
+    assert np.ptp(E) / E[0] < 1e-10, np.ptp(E) / E[0]  # measured 7e-15 over 5 ms
+    forces = planetary_mesh_forces(system, states)
+    assert np.ptp(forces["planet_1_sun_mesh_force_N"]) > 1.0  # it does vibrate (centripetal load)
+
+
+def test_rigid_rolling_with_the_carrier_at_rest_loads_no_mesh():
+    """Carrier at rest (no centripetal load), sun at 300 rad/s, ring and planets at their rolling speeds:
+    over 10 sun revolutions' worth of angle the meshes stay unloaded and the speeds unchanged."""
+    lay = _layout(3, torsion=None)
+    system = build_planetary(lay, sun_speed_rad_s=300.0, carrier_speed_rad_s=0.0)
+    states = solve_planetary(system, 0.2)
+    forces = planetary_mesh_forces(system, states)
+    for name, f in forces.items():
+        assert np.max(np.abs(f)) < 1e-3, name  # of ~800 N under 100 N m
+    speeds = rigid_speeds_rad_s(lay, 300.0, 0.0)
+    assert speeds["ring"] == pytest.approx(-300.0 * RB_S / RB_R)
+    assert states["ring_v"][-1, 2] == pytest.approx(speeds["ring"], rel=1e-9)
+    assert states["planet_2_v"][-1, 2] == pytest.approx(speeds["planet"], rel=1e-9)
