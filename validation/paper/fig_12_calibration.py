@@ -49,10 +49,13 @@ from .fig_12 import CASES, PERIOD_4_S
 
 SCENE = "one-stage"
 CALIBRATED_SCENE = "one-stage-calibrated"
-RECORD_DIR = RESULTS_DIR / "fig_12_calibration"
+RECORD_DIR = RESULTS_DIR / "fig_12_calibration"  # the pre-registered fit's record (and the screening)
 WORKERS = 2
 FIT_CASES = {"(a) E(0.5,12,0.3) C1=0": 1.8, "(d) E(0.5,20,0.3) C1=1000": 2.4}
 FIT_SIGMA = 0.1
+FITTED = ("design.pinion.inertia_kg_m2", "design.wheel.inertia_kg_m2", "design.mesh.damping_Ns_per_m",
+          "design.coupling.stiffness_Nm_per_rad")
+BUDGET, BATCH, POLISH_EVALUATIONS, SEED = 160, 2, 40, 18
 
 
 @dataclass(frozen=True)
@@ -90,7 +93,52 @@ BOUNDS = (
           "C_z = mesh damping ratio 0.03-0.17 of critical, 2 zeta sqrt(k_z m_red), for the reduced mass "
           "of the gear pair between the bare gears (4 kg) and the heaviest pinion side above (20 kg)"),
 )
-BOUND = {b.key: b for b in BOUNDS}
+RATING = Bound("motor_power_kW", 37.0, 110.0,
+               "rated power of the motor at 107 rad/s (one-stage: 75 kW, 700 N m). The pair (module 5, face "
+               "60 mm) carries 160 N/mm of face at 75 kW; 80-240 N/mm (37-110 kW, IEC sizes) is the range of "
+               "through-hardened to case-hardened industrial spur gears; at 37 kW the breakdown torque still "
+               "runs the drive up in 0.5 s. Scales the rated torque, the breakdown torque and the rotor "
+               "inertia (inertia per kW of the speed class) together")
+BOUND = {b.key: b for b in (*BOUNDS, RATING)}
+RATED_KW = 75.0
+SCALED_BY_RATING = {  # scene key: its one-stage value at RATED_KW
+    "design.machine.rated_torque_Nm": 2124.0,
+    "design.motor.breakdown_torque_Nm": 1750.0,
+    "design.motor.inertia_kg_m2": 1.2,
+}
+
+
+def scene_values(values: dict[str, float]) -> dict[str, float]:
+    """Scene keys of a parameter point: the motor rating (a pseudo-parameter) as the keys it scales."""
+    out = {k: float(v) for k, v in values.items() if k != RATING.key}
+    if RATING.key in values:
+        scale = float(values[RATING.key]) / RATED_KW
+        out.update({k: v * scale for k, v in SCALED_BY_RATING.items()})
+    return out
+
+
+@dataclass(frozen=True)
+class Fit:
+    """One calibration: the parameters it fits, where it records, the scene it writes."""
+
+    name: str
+    fitted: tuple[str, ...]
+    scene: str
+    statement: str
+
+    @property
+    def record_dir(self) -> Path:
+        return RESULTS_DIR / self.name
+
+
+FITS = {
+    "fig3": Fit("fig_12_calibration", FITTED, CALIBRATED_SCENE,
+                "Pre-registered fit: the Fig. 3 structure, the four screened parameters, motor at 75 kW."),
+    "rating": Fit("fig_12_calibration_rating", (*FITTED, RATING.key), "one-stage-calibrated-rating",
+                  "Variant, declared after the pre-registered fit left (d) 6 sigma short: same structure, "
+                  "subset and sigma, the motor's rating free as well (it sets F_rated, and K_d - 1 scales "
+                  "as k_z e / F_rated)."),
+}
 
 
 def case_overrides(label: str, e_um: float | None = None) -> list[str]:
@@ -108,7 +156,7 @@ def kd4(scene: str, overrides: list[str], values: dict[str, float]) -> float | N
     from gearbody.model import load_scenario
 
     try:
-        sc = load_scenario(scene, [*overrides, *(f"{k}={float(v)!r}" for k, v in values.items())])
+        sc = load_scenario(scene, [*overrides, *(f"{k}={v!r}" for k, v in scene_values(values).items())])
         res = simulate(sc)
     except GearbodyError as exc:
         print("refused:", type(exc).__name__, str(exc).splitlines()[0][:160])
@@ -124,6 +172,105 @@ def run_batch(jobs: list[tuple], workers: int = WORKERS) -> list[float | None]:
     """K_d4 of (scene, overrides, values) jobs on a process pool of `workers`."""
     with ProcessPoolExecutor(workers) as pool:
         return list(pool.map(_job, jobs))
+
+
+class _Evaluator:
+    """The calibration's batch function: K_d4 of the fit cases of every point, on one process pool."""
+
+    def __init__(self, scene: str, cases: dict[str, float], workers: int = WORKERS):
+        self.scene, self.cases = scene, list(cases)
+        self.pool = ProcessPoolExecutor(workers)
+        self.runs = 0
+
+    def __call__(self, points: list[dict[str, float]]) -> list[dict[str, float] | None]:
+        jobs = [(self.scene, case_overrides(c), p) for p in points for c in self.cases]
+        kds = list(self.pool.map(_job, jobs))
+        self.runs += len(jobs)
+        out = []
+        for n, p in enumerate(points):
+            row = kds[n * len(self.cases):(n + 1) * len(self.cases)]
+            out.append(None if any(k is None for k in row) else dict(zip(self.cases, row, strict=True)))
+            print(" ".join(f"{k.split('.')[-2 if '.' in k else 0]}={v:.4g}" for k, v in p.items()), "->",
+                  out[-1], flush=True)
+        return out
+
+
+def parameters(fit: Fit):
+    from gearbody.studies.calibration import Parameter
+
+    start = {**base_values(), RATING.key: RATED_KW}
+    return [Parameter(k, BOUND[k].lower, BOUND[k].upper, start=start[k], log=True) for k in fit.fitted]
+
+
+def targets():
+    from gearbody.studies.calibration import Target
+
+    return [Target(c, v, FIT_SIGMA) for c, v in FIT_CASES.items()]
+
+
+def identifiability(cache, params, tg, best: dict[str, float]) -> dict:
+    """What the fit's Jacobian (its forward-difference points, read back from the evaluation record) says:
+    the conditional 1-sigma of each parameter (the others held at the optimum: a lower bound) and the
+    singular values in normalised coordinates (a zero: a direction the targets do not identify)."""
+    def residual(features):
+        return np.array([(features[t.feature] - t.value) / t.sigma for t in tg])
+
+    points = {k: (json.loads(k), f) for k, f in cache.values.items() if f is not None}
+    r0 = residual(cache.values[cache.key(best)])
+    columns, conditional = [], {}
+    for p in params:
+        near = [(abs(pt[p.key] - best[p.key]), pt, f) for pt, f in points.values()
+                if pt[p.key] != best[p.key] and all(pt[q.key] == best[q.key] for q in params if q is not p)]
+        _, pt, f = min(near, key=lambda item: item[0])
+        d = (residual(f) - r0) / (pt[p.key] - best[p.key])  # per unit of the parameter
+        conditional[p.key] = float(1.0 / np.linalg.norm(d)) if np.any(d) else float("inf")
+        du = p.to_unit(pt[p.key]) - p.to_unit(best[p.key])
+        columns.append((residual(f) - r0) / du)
+    singular = np.linalg.svd(np.column_stack(columns), compute_uv=False)
+    return {"conditional_sigma": conditional, "singular_values_unit": [float(x) for x in singular],
+            "identified_directions": int(np.sum(singular > 1e-6 * singular[0]))}
+
+
+def run_calibration(fit: Fit) -> dict:
+    """Fit `fit.fitted` to FIT_CASES (resumes from its evaluations.jsonl); writes calibration.json."""
+    from gearbody.model.scenes import scene_path
+    from gearbody.studies.calibration import EvaluationCache, calibrate, fingerprint
+
+    params, tg = parameters(fit), targets()
+    record_dir = fit.record_dir
+    fp = fingerprint(scene_path(SCENE).read_text(), [vars(p) for p in params], [vars(t) for t in tg],
+                     BUDGET, BATCH, POLISH_EVALUATIONS, SEED, PERIOD_4_S, CASES)
+    cache = EvaluationCache(record_dir / "evaluations.jsonl", fp)
+    evaluator = _Evaluator(SCENE, FIT_CASES)
+    t0 = time.perf_counter()
+    try:
+        result = calibrate(evaluator, params, tg, budget=BUDGET, batch=BATCH, polish=True,
+                           polish_evaluations=POLISH_EVALUATIONS, seed=SEED, cache=cache)
+    finally:
+        evaluator.pool.shutdown()
+    wall = time.perf_counter() - t0
+    print(result.table())
+    record = {
+        "fit": fit.name, "statement": fit.statement, "scene": SCENE, "writes_scene": fit.scene,
+        "fitted": list(fit.fitted), "targets": FIT_CASES, "sigma": FIT_SIGMA,
+        "parameters": result.parameters, "sigma_parameters": result.sigma,
+        "correlation": np.asarray(result.correlation).tolist(), "features": result.features,
+        "residuals": result.residuals, "cost": result.cost, "evaluations": result.evaluations,
+        "replayed": result.replayed, "simulations_this_run": evaluator.runs,
+        "simulations": result.evaluations * len(FIT_CASES), "wall_s_this_run": wall,
+        "history": result.history, "budget": BUDGET, "batch": BATCH,
+        "polish_evaluations": POLISH_EVALUATIONS, "seed": SEED, "workers": WORKERS,
+        "bounds": {k: [b.lower, b.upper, b.reason] for k, b in BOUND.items()},
+        **identifiability(cache, params, tg, result.parameters),
+    }
+    previous = record_dir / "calibration.json"
+    if previous.exists() and result.replayed:  # a resumed run: the wall time of the first one counts too
+        record["wall_s_total"] = json.loads(previous.read_text()).get("wall_s_total", 0.0) + wall
+    else:
+        record["wall_s_total"] = wall
+    (record_dir / "calibration.json").write_text(json.dumps(record, indent=1))
+    (record_dir / "calibration.txt").write_text(result.table() + "\n")
+    return record
 
 
 def screen() -> dict:
@@ -161,11 +308,80 @@ def base_values() -> dict[str, float]:
     return values
 
 
-def main(quick: bool = False, do_screen: bool = False, do_calibrate: bool = False) -> None:
+SCENE_HEADER = """\
+# One-stage gearbox system of the paper's Fig. 3 (eqs. 2-6), CALIBRATED: the `one-stage` scene with the
+# parameters the paper does not state identified from the paper's own Fig. 12 (a) K_d4 = 1.8 and
+# (d) K_d4 = 2.4 (sigma 0.1 each) by validation/paper/fig_12_calibration.py (record:
+# validation/paper/results/{record}/calibration.json). `one-stage` stays the documented scene;
+# this one exists to test the paper's other claims as predictions of one identified parameter set.
+# {statement}
+#
+# Identified (log-scaled search within these bounds; reasons in the script's BOUNDS table; conditional
+# sigma: from the Jacobian column of the parameter alone, the others held at the optimum):
+{identified}
+# Everything else as scenes/one-stage.toml (mesh stiffness of the paper's Fig. 4, rated speed 107 rad/s,
+# geometry z 29/88 module 5, backlash, friction, error-mode seed, the four periods).
+"""
+
+
+def scene_text(fit: Fit, record: dict) -> str:
+    """A fit's calibrated scene: one-stage.toml with the record's values, its header and meta replaced."""
+    from gearbody.model.scenes import scene_path
+
+    values, sigma = record["parameters"], record["conditional_sigma"]
+    keys = scene_values(values)
+    lines = scene_path(SCENE).read_text().splitlines()
+    body = lines[next(i for i, line in enumerate(lines) if line.startswith("[")):]
+    section, out = "", []
+    for line in body:
+        if line.startswith("["):
+            section = line.strip("[] ")
+        key = line.split("=", 1)[0].strip()
+        full = f"{section}.{key}"
+        if full in keys:
+            line = f"{key} = {keys[full]:.6g}"
+        elif section == "meta" and key == "title":
+            line = 'title = "One-stage gearbox system, Fig. 3, calibrated on the paper\'s Fig. 12 (a), (d)"'
+        elif section == "meta" and line.startswith('  "Kloss'):
+            line += ("\n  \"identified from the paper's Fig. 12 (a), (d) by "
+                     f"validation/paper/fig_12_calibration.py ({', '.join(fit.fitted)} within stated "
+                     "bounds)\",")
+        out.append(line)
+    identified = [
+        f"# - {k} = {values[k]:.6g} (conditional 1 sigma {sigma[k]:.2g}), "
+        f"bounds [{BOUND[k].lower:g}, {BOUND[k].upper:g}]"
+        for k in fit.fitted
+    ]
+    identified.append(
+        f"# {len(FIT_CASES)} targets identify {record['identified_directions']} directions of these "
+        f"{len(fit.fitted)} parameters:\n# the set is one point of a family that fits as well; the fit "
+        f"leaves (a), (d) at " + ", ".join(f"{v:.2f}" for v in record["features"].values())
+        + f" (chi^2/2 = {record['cost']:.3g}).")
+    if RATING.key in fit.fitted:
+        identified.append("#   (the rating sets " + ", ".join(
+            f"{k} = {v:.6g}" for k, v in keys.items() if k in SCALED_BY_RATING) + ")")
+    header = SCENE_HEADER.format(record=fit.name, statement=fit.statement, identified="\n".join(identified))
+    return header + "\n" + "\n".join(out) + "\n"
+
+
+def write_scene(fit: Fit, record: dict) -> Path:
+    from gearbody.model.scenes import scene_dir
+
+    path = scene_dir() / f"{fit.scene}.toml"
+    path.write_text(scene_text(fit, record))
+    return path
+
+
+def main(quick: bool = False, do_screen: bool = False, do_calibrate: bool = False, fit: str = "fig3") -> None:
     if do_screen:
         screen()
         return
-    raise SystemExit("not yet")
+    if do_calibrate:
+        write_scene(FITS[fit], run_calibration(FITS[fit]))
+        return
+    from .fig_12_predictions import predict
+
+    predict(quick)
 
 
 if __name__ == "__main__":
@@ -173,5 +389,6 @@ if __name__ == "__main__":
     p.add_argument("--screen", action="store_true", help="one-at-a-time screening of the bounded parameters")
     p.add_argument("--calibrate", action="store_true", help="run (or resume) the calibration")
     p.add_argument("--quick", action="store_true", help="fewer prediction runs")
+    p.add_argument("--fit", choices=sorted(FITS), default="fig3", help="which calibration (default fig3)")
     a = p.parse_args()
-    main(a.quick, a.screen, a.calibrate)
+    main(a.quick, a.screen, a.calibrate, a.fit)
