@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import textwrap
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
@@ -312,9 +313,10 @@ SCENE_HEADER = """\
 # One-stage gearbox system of the paper's Fig. 3 (eqs. 2-6), CALIBRATED: the `one-stage` scene with the
 # parameters the paper does not state identified from the paper's own Fig. 12 (a) K_d4 = 1.8 and
 # (d) K_d4 = 2.4 (sigma 0.1 each) by validation/paper/fig_12_calibration.py (record:
-# validation/paper/results/{record}/calibration.json). `one-stage` stays the documented scene;
-# this one exists to test the paper's other claims as predictions of one identified parameter set.
-# {statement}
+# validation/paper/results/{record}/calibration.json).
+# `one-stage` stays the documented scene; this one exists to test the paper's other claims as
+# predictions of one identified parameter set.
+{statement}
 #
 # Identified (log-scaled search within these bounds; reasons in the script's BOUNDS table; conditional
 # sigma: from the Jacobian column of the parameter alone, the others held at the optimum):
@@ -322,6 +324,10 @@ SCENE_HEADER = """\
 # Everything else as scenes/one-stage.toml (mesh stiffness of the paper's Fig. 4, rated speed 107 rad/s,
 # geometry z 29/88 module 5, backlash, friction, error-mode seed, the four periods).
 """
+
+
+def _comment(text: str) -> str:
+    return textwrap.fill(text, 106, initial_indent="# ", subsequent_indent="# ")
 
 
 def scene_text(fit: Fit, record: dict) -> str:
@@ -358,9 +364,10 @@ def scene_text(fit: Fit, record: dict) -> str:
         f"leaves (a), (d) at " + ", ".join(f"{v:.2f}" for v in record["features"].values())
         + f" (chi^2/2 = {record['cost']:.3g}).")
     if RATING.key in fit.fitted:
-        identified.append("#   (the rating sets " + ", ".join(
-            f"{k} = {v:.6g}" for k, v in keys.items() if k in SCALED_BY_RATING) + ")")
-    header = SCENE_HEADER.format(record=fit.name, statement=fit.statement, identified="\n".join(identified))
+        identified.append(_comment("(the rating sets " + ", ".join(
+            f"{k} = {v:.6g}" for k, v in keys.items() if k in SCALED_BY_RATING) + ")"))
+    header = SCENE_HEADER.format(record=fit.name, statement=_comment(fit.statement),
+                                 identified="\n".join(identified))
     return header + "\n" + "\n".join(out) + "\n"
 
 
