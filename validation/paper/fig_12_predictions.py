@@ -60,7 +60,7 @@ def fig_12_claims(k: dict[str, float], further: dict[str, float]) -> tuple[list[
         Claim("12", "a larger e raises K_d (a -> b, c -> d)", f"{a:.2f} -> {b:.2f}; {c:.2f} -> {d:.2f}",
               b > a and d > c),
         Claim("12", "a smaller random scope r lowers K_d slightly (d -> e: 2.4 -> 2.3)",
-              f"{d:.2f} -> {e:.2f}", e < d),
+              f"{d:.3f} -> {e:.3f}", e < d),
         Claim("12", "moving the error apex to a = 0.1 raises K_d strongly (d -> f: 2.4 -> 4.7)",
               f"{d:.2f} -> {f:.2f}", f > 1.5 * d),
     ]
@@ -90,6 +90,17 @@ def figs_13_16_claims(scene: str) -> list[Claim]:
     }
     _, wideband, share, lines, failed = figs_13_16.run_series(runs)
     return figs_13_16._claims(f"factors ({scene})", wideband, share, lines, failed)
+
+
+ZETA_RANGE = (0.03, 0.17)
+"""The mesh damping ratios the C_z bound's reason states."""
+
+
+def _damping_check(scene: str, zeta: float) -> tuple[float, dict[str, float | None]]:
+    """The fit cases with C_z raised to the lowest stated damping ratio: (that C_z, K_d4 by case)."""
+    c_z = load_scenario(scene).stages[0].mesh.damping_Ns_per_m * ZETA_RANGE[0] / zeta
+    kds = run_batch([(scene, case_overrides(c), {"design.mesh.damping_Ns_per_m": c_z}) for c in FIT_CASES])
+    return float(c_z), dict(zip(FIT_CASES, kds, strict=True))
 
 
 def _mesh_damping_ratio(scene: str) -> tuple[float, float, list[float]]:
@@ -131,8 +142,9 @@ def _plot(kd: dict, further: dict, path, title: str):
     return save_figure(fig, path, 100)
 
 
-def predict_fit(fit: Fit, record: dict, quick: bool = False) -> tuple[list[str], list[Claim], list[Claim]]:
-    """Run the predictions on a fit's scene: (markdown lines, fitted claims, predicted claims)."""
+def predict_fit(fit: Fit, record: dict, quick: bool = False) -> tuple[list, list[Claim], list[Claim], dict]:
+    """Run the predictions on a fit's scene: (markdown lines, fitted claims, predicted claims, K_d4 by
+    case)."""
     with Timer() as timer:
         kd, further = fig_12_runs(fit.scene)
         for label, v in {**kd, **further}.items():
@@ -142,38 +154,102 @@ def predict_fit(fit: Fit, record: dict, quick: bool = False) -> tuple[list[str],
         predicted += c9
         predicted += figs_13_16_claims(fit.scene)
     zeta, m_red, modes = _mesh_damping_ratio(fit.scene)
+    damping_check = _damping_check(fit.scene, zeta) if zeta < ZETA_RANGE[0] else None
     RESULTS_DIR.mkdir(parents=True, exist_ok=True)
     fig = _plot(kd, further, RESULTS_DIR / f"{fit.name}_kd4.png",
                 f"{fit.scene}: Fig. 12 cases (bars) and the paper's values (red)")
     lines = _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, timer.s, fig)
+    if damping_check is not None:
+        c_z, kd_fit = damping_check
+        at = lines.index("#### Fitted claims (used in the fit: not evidence)")
+        lines[at:at] = [
+            f"The identified C_z lies inside its numeric bound, but its damping ratio {zeta:.3f} is below "
+            f"the {ZETA_RANGE[0]} that the bound's reason states (the C_z bound was set for reduced masses "
+            f"of 4-20 kg; it admits {zeta:.3f} at {m_red:.1f} kg). With C_z raised to the "
+            f"ratio {ZETA_RANGE[0]} ({c_z:.0f} N s/m), the fit cases give K_d4 "
+            + ", ".join(f"{k.split(' ')[0]} {v:.2f}" if v is not None else f"{k.split(' ')[0]} refused"
+                        for k, v in kd_fit.items()) + " (2 runs).", ""]
     for c in fitted + predicted:
         print(f"[{'PASS' if c.passed else 'FAIL'}] {c.figure}: {c.claim} -- {c.measured}")
-    return lines, fitted, predicted
+    return lines, fitted, predicted, {**kd, **further}
 
 
 def predict(quick: bool = False) -> None:
     """Predictions of every fit with a record; writes results/fig_12_calibration.md/.json (the
     pre-registered fit's predicted claims are the `claims` that run_all counts)."""
-    parts = ["## Calibrated drive: Fig. 12 by calibration, the other claims as predictions", ""]
     data: dict = {"title": "Calibrated drive", "wall_s": 0.0}
+    bodies, summary, kds = [], [], {}
     for key, fit in FITS.items():
         path = fit.record_dir / "calibration.json"
         if not path.exists():
             continue
         record = json.loads(path.read_text())
         with Timer() as timer:
-            lines, fitted, predicted = predict_fit(fit, record, quick)
-        parts += lines
+            lines, fitted, predicted, kds[key] = predict_fit(fit, record, quick)
+        bodies += lines
         data["wall_s"] += timer.s + record["wall_s_total"]
-        if key == "fig3":
-            data["claims"] = [asdict(c) for c in predicted]
-            data["fitted_claims"] = [asdict(c) for c in fitted]
-        else:
-            data[f"{key}_claims"] = [asdict(c) for c in predicted]
-            data[f"{key}_fitted_claims"] = [asdict(c) for c in fitted]
-    parts += needs()
+        prefix = "" if key == "fig3" else f"{key}_"
+        data[f"{prefix}claims"] = [asdict(c) for c in predicted]
+        data[f"{prefix}fitted_claims"] = [asdict(c) for c in fitted]
+        n12 = [c for c in predicted if c.figure == "12"]
+        short = ", ".join(f"`{k.split('.')[-2] if '.' in k else k}`" for k in fit.fitted)
+        summary.append(
+            f"| `{fit.scene}` | {short} | "
+            + " | ".join(f"{v:.2f} ({FIT_CASES[c]}, {r:+.1f} sigma)" for (c, v), r in
+                         zip(record["features"].items(), record["residuals"].values(), strict=True))
+            + f" | {record['cost']:.3g} | {sum(c.passed for c in predicted)} / {len(predicted)} | "
+            f"{sum(c.passed for c in n12)} / {len(n12)} |")
+    parts = [
+        "## Calibrated drive: Fig. 12 by calibration, the other claims as predictions", "",
+        "| scene | fitted | (a) K_d4 fitted (paper) | (d) K_d4 fitted (paper) | chi^2/2 | predicted claims "
+        "passed | of them Fig. 12 |", "|---|---|---|---|---|---|---|", *summary, "",
+    ]
+    need_lines, need_kd = needs()
+    parts += [*_reading(kds, need_kd), "", *bodies, *need_lines]
     (RESULTS_DIR / f"{NAME}.md").write_text("\n".join(parts))
     (RESULTS_DIR / f"{NAME}.json").write_text(json.dumps(data, indent=2))
+
+
+def _within(v: float | None, paper: str) -> bool:
+    if v is None:
+        return False
+    if paper in ("unstable", "stable"):
+        return (v > 2.0) == (paper == "unstable")
+    return abs(v - float(paper)) <= 0.25 * float(paper)
+
+
+def _reading(kds: dict[str, dict], need_kd: dict[str, float | None]) -> list[str]:
+    """The summary's reading, its numbers (and its verbs) from the runs."""
+    labels = list(CASES)
+    out = []
+    if "fig3" in kds:
+        k = kds["fig3"]
+        out.append(
+            f"- Pre-registered fit (Fig. 3 structure, 75 kW): the search found no set inside the bounds that "
+            f"reaches (d): the best leaves K_d4 (d) at {k[labels[3]]:.2f} against 2.4. C_1 "
+            f"{'lowers' if k[labels[2]] < k[labels[1]] else 'does not lower'} K_d (b -> c "
+            f"{k[labels[1]]:.2f} -> {k[labels[2]]:.2f}); (f) {k[labels[5]]:.2f} against 4.7.")
+    if "rating" in kds:
+        k = kds["rating"]
+        out.append(
+            f"- Variant (rating free): (a), (d) fitted to {k[labels[0]]:.2f}, {k[labels[3]]:.2f}; (f) "
+            f"predicted at {k[labels[5]]:.2f} (paper 4.7); the rating ends at its lower bound and the wheel "
+            f"inertia near its upper one (see its table: the data pull out of the plausible box); C_1 "
+            f"{'lowers' if k[labels[2]] < k[labels[1]] else 'does not lower'} K_d (b -> c "
+            f"{k[labels[1]]:.2f} -> {k[labels[2]]:.2f}); (b) K_d4 {k[labels[1]]:.2f}.")
+    if kds:
+        dr = {key: k[labels[4]] - k[labels[3]] for key, k in kds.items()}
+        rs = ", ".join(f"{key}: {k[labels[3]]:.3f} -> {k[labels[4]]:.3f}" for key, k in kds.items())
+        further = "; ".join(f"{key}: {k[labels[5]]:.2f} / " + " / ".join(
+            f"{v:.2f}" for v in list(k.values())[len(labels):]) for key, k in kds.items())
+        out.append(f"- The r effect (d -> e): changes of {', '.join(f'{v:+.3f}' for v in dr.values())} "
+                   f"({rs}); below 0.01 it is not evidence either way.")
+        out.append(f"- (f)'s 'if e is increased further, K_d does not change': K_d4 at e = 20 / 25 / 30 um: "
+                   f"{further}.")
+    ok = [label.split(" ")[0] for label in labels if _within(need_kd.get(label), CASES[label][4])]
+    out.append(f"- Diagnostic (last table): with the error imposed as mesh deflection (heavy gears) the "
+               f"model gives {', '.join(ok) or 'none'} of the six cases within the claims' tolerances.")
+    return out
 
 
 def _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, predict_s, fig) -> list[str]:
@@ -230,9 +306,11 @@ def _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, predic
 
 # -- what the model would need --------------------------------------------------------------------------
 NEEDS_INERTIA = {"design.pinion.inertia_kg_m2": 15.0, "design.wheel.inertia_kg_m2": 150.0}
-"""Gear inertias ~70x the plausible ones: the pair's mesh mode (137 Hz) far below the mesh frequency, in
+"""Gear inertias ~70x the plausible ones: the pair's mesh mode (138 Hz) far below the mesh frequency, in
 steady rated running (such a drive could not run up in 0.5 s): a diagnostic only."""
-NEEDS_SETTLE_S, NEEDS_RECORD_S = 0.3, 0.3
+NEEDS_DAMPING_RATIO = 0.05
+"""The mesh damping of the heavy pair: the damping ratio of `one-stage` (7000 N s/m on 3.99 kg)."""
+NEEDS_SETTLE_S, NEEDS_RECORD_S = 0.5, 0.3
 
 
 def imposed_error_kd(a_e_r: tuple[float, float, float], scene: str = "one-stage") -> float:
@@ -263,7 +341,7 @@ def _steady_kd(overrides: list[str]) -> float | None:
     return float(np.max(res.kd[res.time_s >= NEEDS_SETTLE_S]))
 
 
-def needs() -> list[str]:
+def needs() -> tuple[list[str], dict[str, float | None]]:
     """Runs showing what the paper's numbers need: the one-stage drive with the gear inertias far above
     the plausible ones (mesh mode far below the mesh frequency), beside the imposed-error estimate."""
     from concurrent.futures import ProcessPoolExecutor
@@ -271,7 +349,13 @@ def needs() -> list[str]:
     from gearbody.errors import GearbodyError
 
     labels = list(CASES)
-    big = [f"{k}={v}" for k, v in NEEDS_INERTIA.items()]
+    sc = load_scenario("one-stage")
+    st = sc.stages[0]
+    m_red = 1.0 / (st.pinion.base_radius_m ** 2 / NEEDS_INERTIA["design.pinion.inertia_kg_m2"]
+                   + st.wheel.base_radius_m ** 2 / NEEDS_INERTIA["design.wheel.inertia_kg_m2"])
+    k_mean = 0.5 * (st.mesh.stiffness_single_N_per_m + st.mesh.stiffness_double_N_per_m)
+    c_z = NEEDS_DAMPING_RATIO * 2.0 * np.sqrt(k_mean * m_red)
+    big = [f"{k}={v}" for k, v in NEEDS_INERTIA.items()] + [f"design.mesh.damping_Ns_per_m={c_z:.1f}"]
     with Timer() as timer, ProcessPoolExecutor(2) as pool:
         kds = list(pool.map(_steady_kd, [[*case_overrides(c), *big] for c in labels]))
     try:
@@ -290,7 +374,9 @@ def needs() -> list[str]:
         "k_z, F_rated and the scene's random tooth depths). In the Fig. 3 structure at this geometry that "
         "needs a reduced mass of the pair >> 130 kg (its mesh mode well below 494 Hz), gear inertias far "
         "outside their bounds. The run column: the one-stage drive with "
-        f"{', '.join(f'{k} = {v:g}' for k, v in NEEDS_INERTIA.items())} (mesh mode {f_mesh:.0f} Hz) in "
+        f"{', '.join(f'{k} = {v:g}' for k, v in NEEDS_INERTIA.items())} (reduced mass {m_red:.0f} kg, mesh "
+        f"mode {f_mesh:.0f} Hz) and C_z = {c_z:.3g} N s/m (damping ratio {NEEDS_DAMPING_RATIO}, as "
+        "one-stage's) in "
         f"steady rated running (such a drive could not run up in 0.5 s), max K_d over {NEEDS_RECORD_S} s "
         f"after {NEEDS_SETTLE_S} s; {timer.s:.0f} s wall.", "", *rows, "",
-    ]
+    ], dict(zip(labels, kds, strict=True))
