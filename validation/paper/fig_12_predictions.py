@@ -1,9 +1,12 @@
-"""The calibrated drive's predictions: the paper's claims not used in the fit of fig_12_calibration.py,
-run on `scenes/one-stage-calibrated.toml` (or a variant scene), and the "Calibrated drive" results file.
+"""The calibrated drives' predictions: the paper's claims not used in the fits of fig_12_calibration.py,
+run on the scenes the fits wrote (`one-stage-calibrated`, the variant `one-stage-calibrated-rating`), and
+the "Calibrated drive" results file.
 
 Fitted claims (Fig. 12 (a), (d)) and predicted claims go to separate tables of
-results/fig_12_calibration.md; results/fig_12_calibration.json holds the predicted claims as `claims`
-(what run_all counts) and the fitted ones as `fitted_claims`.
+results/fig_12_calibration.md; results/fig_12_calibration.json holds the pre-registered fit's predicted
+claims as `claims` (what run_all counts), its fitted ones as `fitted_claims`, the variant's as
+`rating_claims` / `rating_fitted_claims`. The last section is a diagnostic (heavy gears, steady running)
+of what the paper's numbers need; it calibrates nothing.
 """
 
 from __future__ import annotations
