@@ -32,12 +32,13 @@ def damaged_tooth_run(damage: str | None, record_s: float):
     return res, res.time_s >= SETTLE_S
 
 
-def tooth_run(stiffness_factor: float | None, record_s: float):
-    """Steady rated one-stage run with pinion tooth BROKEN_TOOTH at this stiffness factor (None: healthy)."""
+def tooth_run(stiffness_factor: float | None, record_s: float, scene: str = "one-stage"):
+    """Steady rated run of a one-stage scene with pinion tooth BROKEN_TOOTH at this stiffness factor (None:
+    healthy)."""
     overrides = [*steady_overrides(1.0, SETTLE_S + record_s), ERROR]
     if stiffness_factor is not None:
         overrides.append(
             f'condition.damaged_teeth=[{{gear="pinion",tooth={BROKEN_TOOTH},stiffness_factor={stiffness_factor}}}]'
         )
-    res = simulate(load_scenario("one-stage", overrides))
+    res = simulate(load_scenario(scene, overrides))
     return res, res.time_s >= SETTLE_S

@@ -25,9 +25,9 @@ SETTLE_S, RECORD_S = 0.1, 0.1
 MODES = {"a: E(0.1, e, 0)": (0.1, 1.0), "b: E(0.5, e, 0)": (0.5, 1.0), "c: E(0.5, -e, 0)": (0.5, -1.0)}
 
 
-def kd_max(a: float, e_um: float) -> float:
+def kd_max(a: float, e_um: float, scene: str = "one-stage") -> float:
     sc = load_scenario(
-        "one-stage",
+        scene,
         [
             *steady_overrides(1.0, SETTLE_S + RECORD_S),
             f"production.error_mode={{a={a},e_um={e_um},r=0.0}}",
@@ -49,20 +49,46 @@ def threshold(e: np.ndarray, kd: np.ndarray, level: float = 2.0) -> float:
     return float(e[k - 1] + (level - kd[k - 1]) * (e[k] - e[k - 1]) / (kd[k] - kd[k - 1]))
 
 
-def main(quick: bool = False) -> None:
-    e_values = np.array([0, 10, 20, 40, 60] if quick else [0, 5, 10, 15, 20, 25, 30, 40, 50, 60, 80], float)
-    curves = {}
-    with Timer() as timer:
-        for label, (a, sign) in MODES.items():
-            curves[label] = np.array([kd_max(a, sign * e) for e in e_values])
-            print(label, np.round(curves[label], 3))
+def e_grid(quick: bool = False) -> np.ndarray:
+    return np.array([0, 10, 20, 40, 60] if quick else [0, 5, 10, 15, 20, 25, 30, 40, 50, 60, 80], float)
 
+
+def curves_of(scene: str, e_values: np.ndarray) -> dict[str, np.ndarray]:
+    """K_d max against e for every error mode of MODES on a scene."""
+    curves = {}
+    for label, (a, sign) in MODES.items():
+        curves[label] = np.array([kd_max(a, sign * e, scene) for e in e_values])
+        print(label, np.round(curves[label], 3))
+    return curves
+
+
+def main(quick: bool = False) -> None:
+    e_values = e_grid(quick)
+    with Timer() as timer:
+        curves = curves_of("one-stage", e_values)
     fig = new_figure((900, 500), 100)
     ax = fig.add_subplot(1, 1, 1)
+    claims, notes = check(curves, e_values, ax)
+    ax.axhline(2.0, color="red", lw=0.8, ls=":", label="K_d = 2")
+    ax.set_xlabel("error e [um]")
+    ax.set_ylabel("K_d max (steady rated running)")
+    ax.set_title("one-stage, C_1 = 0, r = 0: K_d against the error e")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
+    figs = [save_figure(fig, RESULTS_DIR / "fig_09_kd_vs_e.png", 100)]
+    e_list = ", ".join(f"{e:.0f}" for e in e_values)
+    notes.append(f"e values {e_list} um; settle {SETTLE_S} s, record {RECORD_S} s.")
+    write_results("fig_09", "Fig. 9: K_d against the error e", claims, notes, figs, timer.s)
+
+
+def check(curves: dict[str, np.ndarray], e_values: np.ndarray, ax=None) -> tuple[list[Claim], list[str]]:
+    """The paper's Fig. 9 claims on K_d-against-e curves (plotted on `ax` when given)."""
     claims, notes = [], []
     thresholds = {}
     for label, kd in curves.items():
-        ax.plot(e_values, kd, "o-", label=label)
+        if ax is not None:
+            ax.plot(e_values, kd, "o-", label=label)
         thresholds[label] = threshold(e_values, kd)
         stable = kd <= 2.0
         if np.count_nonzero(stable) >= 3:
@@ -92,17 +118,7 @@ def main(quick: bool = False) -> None:
     )
     claims.append(Claim("9", "the threshold e depends on a (a = 0.1 vs 0.5)", f"{shown(ta)} vs {shown(tb)}",
                         differs))
-    ax.axhline(2.0, color="red", lw=0.8, ls=":", label="K_d = 2")
-    ax.set_xlabel("error e [um]")
-    ax.set_ylabel("K_d max (steady rated running)")
-    ax.set_title("one-stage, C_1 = 0, r = 0: K_d against the error e")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    figs = [save_figure(fig, RESULTS_DIR / "fig_09_kd_vs_e.png", 100)]
-    e_list = ", ".join(f"{e:.0f}" for e in e_values)
-    notes.append(f"e values {e_list} um; settle {SETTLE_S} s, record {RECORD_S} s.")
-    write_results("fig_09", "Fig. 9: K_d against the error e", claims, notes, figs, timer.s)
+    return claims, notes
 
 
 if __name__ == "__main__":
