@@ -30,6 +30,9 @@ CASES = {
     "(f) E(0.1,20,0.3) C1=1000": (0.1, 20.0, 0.3, 1000.0, "4.7"),
 }
 PERIOD_4_S = 1.3  # rated load from 1.2 s; 0.1 s to settle
+RESOLVED_KD_CHANGE = 0.03
+"""Smallest change of K_d4 counted as an effect: twice the seed-to-seed spread of K_d4 (std 0.013-0.016
+over error-mode seeds 1-5 on the calibrated drive's fit cases, fig_12_predictions.seed_scatter)."""
 
 
 def run(a, e, r, c1, t_end):
@@ -68,7 +71,8 @@ def main(quick: bool = False) -> None:
         v = kd4[label]
         if paper in ("unstable", "stable"):
             agree = (v > 2.0) == (paper == "unstable")
-            claims.append(Claim("12", f"{label}: {paper}", f"K_d4 = {v:.2f}", agree))
+            claims.append(Claim("12", f"{label}: {paper}", f"K_d4 = {v:.2f}", agree,
+                                "K_d4 > 2" if paper == "unstable" else "K_d4 <= 2"))
         else:
             p = float(paper)
             agree = abs(v - p) <= 0.25 * p
@@ -79,7 +83,8 @@ def main(quick: bool = False) -> None:
         Claim("12", "a larger e raises K_d (a -> b, c -> d)",
               f"{k[0]:.2f} -> {k[1]:.2f}; {k[2]:.2f} -> {k[3]:.2f}", k[1] > k[0] and k[3] > k[2]),
         Claim("12", "a smaller random scope r lowers K_d slightly (d -> e: 2.4 -> 2.3)",
-              f"{k[3]:.2f} -> {k[4]:.2f}", k[4] < k[3]),
+              f"{k[3]:.3f} -> {k[4]:.3f}", k[4] < k[3] - RESOLVED_KD_CHANGE,
+              f"by more than {RESOLVED_KD_CHANGE} (the seed scatter)"),
         Claim("12", "moving the error apex to a = 0.1 raises K_d strongly (d -> f: 2.4 -> 4.7)",
               f"{k[3]:.2f} -> {k[5]:.2f}", k[5] > 1.5 * k[3]),
     ]
