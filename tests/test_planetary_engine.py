@@ -153,3 +153,65 @@ def test_the_exudyn_stage_at_rest_has_the_lin_parker_natural_frequencies(angles_
     f_lp = np.sort([g.frequency_hz for g in modes.groups for _ in range(g.multiplicity)])
     assert f_exudyn.size == f_lp.size == 21
     np.testing.assert_allclose(f_exudyn, f_lp, rtol=1e-5)
+
+
+def _phasing_stage(z_s: int, z_p: int, z_r: int) -> tuple[PlanetaryLayout, float]:
+    """Three equally spaced planets, time-varying mesh stiffness (4e8 / 6e8 N/m, contact ratio 1.6), ring
+    held, carrier loaded by a viscous damper; returns the layout and the steady carrier speed."""
+    from gearbody.physics.planetary import PlanetaryGeometry
+
+    g = PlanetaryGeometry(z_sun=z_s, z_planet=z_p, z_ring=z_r, n_planets=3, module_m=MODULE)
+    rbs, rbp, rbr = g.sun_base_radius_m, g.planet_base_radius_m, g.ring_base_radius_m
+
+    def mesh(z1, z2, r1, r2):
+        return pack_mesh_parameters(
+            r1_m=r1, r2_m=r2, z1=z1, z2=z2, stiffness_single_N_per_m=4e8, stiffness_double_N_per_m=6e8,
+            contact_ratio=1.6, damping_Ns_per_m=1500.0, backlash_m=0.0, friction_coefficient=0.0,
+            pitch_point_phase=0.5, pressure_angle_rad=ALPHA0, error_a=0.0, error_depths_m=np.zeros(z1),
+        )  # fmt: skip
+
+    c_load = 24.3
+    rs, rp, rr = g.sun_pitch_radius_m, g.planet_pitch_radius_m, g.ring_pitch_radius_m
+    lay = PlanetaryLayout(
+        sun=PlanetaryMember("sun", 0.5, 0.25 * rs**2, 1e8, 1000.0),
+        ring=PlanetaryMember("ring", 3.0, 3.0 * rr**2, 1e8, 1000.0, 1e7, 20.0),
+        carrier=PlanetaryMember("carrier", 5.0, 3.0 * (rs + rp) ** 2, 1e8, 1000.0, 0.0, c_load),
+        planet=PlanetaryMember("planet", 0.8, 0.4 * rp**2, 1e8, 1000.0),
+        planet_angles_rad=g.planet_angles_rad or tuple(2 * math.pi * k / 3 for k in range(3)),
+        carrier_radius_m=g.carrier_radius_m,
+        base_radius_sun_m=rbs, base_radius_planet_m=rbp, base_radius_ring_m=rbr,
+        sun_mesh=mesh(z_s, z_p, rbs, rbp), ring_mesh=mesh(z_r, z_p, rbr, rbp),
+    )  # fmt: skip
+    return lay, 100.0 * (1 + rbr / rbs) / c_load
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "teeth", [(21, 30, 81), (22, 29, 80)]
+)  # in phase (z_s, z_r multiples of N); sequential
+def test_each_planets_mesh_phase_follows_from_its_position_and_the_teeth(teeth):
+    """Steady running under a sun torque: the mesh-frequency component of planet n's sun- and ring-mesh
+    forces lags planet 1's by the delays of gearbody.physics.planetary.planet_mesh_phases (z psi_n / 2 pi
+    mod 1 of a mesh period; no phase parameter was given to the Exudyn model: they come from the planets'
+    positions). Measured: in phase 0 / 0 / 0; sequential 0 / 0.330 / 0.666 against 0 / 1/3 / 2/3."""
+    from gearbody.physics.planetary import PlanetaryGeometry, planet_mesh_phases
+
+    z_s, z_p, z_r = teeth
+    lay, w_c = _phasing_stage(*teeth)
+    w_s = w_c * (1 + lay.base_radius_ring_m / lay.base_radius_sun_m)
+    system = build_planetary(lay, torques_Nm={"sun": 100.0}, sun_speed_rad_s=w_s, carrier_speed_rad_s=w_c)
+    states = solve_planetary(system, 0.25)
+    forces = planetary_mesh_forces(system, states)
+    t = states["time_s"]
+    sel = t > 0.2
+    f_m = z_s * (states["sun_v"][sel, 2].mean() - states["carrier_v"][sel, 2].mean()) / (2 * math.pi)
+    g = PlanetaryGeometry(z_sun=z_s, z_planet=z_p, z_ring=z_r, n_planets=3, module_m=MODULE)
+    expected = planet_mesh_phases(g).delays(sun_ccw_relative_to_carrier=True)
+    for mesh, delays in zip(("sun", "ring"), expected, strict=True):
+        c = [
+            np.trapezoid((f - f.mean()) * np.exp(-2j * math.pi * f_m * t[sel]), t[sel])
+            for f in (forces[f"planet_{k}_{mesh}_mesh_force_N"][sel] for k in (1, 2, 3))
+        ]
+        lag = [(-np.angle(ck / c[0]) / (2 * math.pi)) % 1.0 for ck in c]
+        for measured, want in zip(lag, delays, strict=True):
+            assert min(abs(measured - want), 1 - abs(measured - want)) < 0.01, (mesh, lag, delays)
