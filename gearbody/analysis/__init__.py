@@ -29,6 +29,13 @@ from gearbody.analysis.indicators import (
 from gearbody.analysis.kinematics import GearMesh, KinematicLine, KinematicSources, Shaft, kinematic_lines
 from gearbody.analysis.peak_report import peaks_table, peaks_to_rows
 from gearbody.analysis.peaks import LabelledPeak, label_peaks
+from gearbody.analysis.planet_pass import (
+    HannPassWindow,
+    phasing_excitation,
+    ring_sensor_signal,
+    surviving_lines,
+)
+from gearbody.analysis.planetary_lines import PlanetaryLine, PlanetarySources, planetary_lines
 from gearbody.analysis.psd import Psd, power_spectral_density
 from gearbody.analysis.spectrum import (
     Peak,
@@ -43,6 +50,13 @@ from gearbody.analysis.spectrum import (
 from gearbody.analysis.tsa import AngleDomainSignal, SynchronousAverage, angle_resample, synchronous_average
 
 __all__ = [
+    "HannPassWindow",
+    "PlanetaryLine",
+    "PlanetarySources",
+    "phasing_excitation",
+    "planetary_lines",
+    "ring_sensor_signal",
+    "surviving_lines",
     "GearMesh",
     "KinematicLine",
     "KinematicSources",
