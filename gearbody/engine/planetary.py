@@ -1,10 +1,10 @@
 """Exudyn system of a planetary stage (issue 19, first step: the stage alone, with constant external
 torques): sun, ring, carrier and every planet are planar rigid bodies (``NodeRigidBody2D`` +
 ``ObjectRigidBody2D``: x, y, theta in the fixed frame, the planets' centres moving on the carrier's circle);
-the central members' supports are coordinate spring-dampers to the ground; each planet's two meshes and
-its bearing on the carrier are one ``ObjectGenericODE2`` on the (sun, ring, carrier, planet) nodes calling
-the compiled :func:`gearbody.physics.planetary_mesh.planet_forces`. Exudyn's planar rigid-body equations
-carry the planets' centripetal and Coriolis effects; nothing is linearised.
+the central members' supports are coordinate spring-dampers to the ground; every planet's two meshes and
+its bearing on the carrier are one ``ObjectGenericODE2`` on all the stage's nodes calling the compiled
+:func:`gearbody.physics.planetary_mesh.stage_forces` (one Python call per right-hand side). Exudyn's
+planar rigid-body equations carry the planets' centripetal and Coriolis effects; nothing is linearised.
 
 Node coordinates are displacements from the nominal assembly (reference coordinates: the planets'
 centres on the carrier circle); the user functions add the reference to get absolute coordinates.
@@ -29,7 +29,7 @@ from exudyn.itemInterface import (
 )
 
 from ..assembly.planetary_layout import CENTRAL, PlanetaryLayout, rigid_speeds_rad_s
-from ..physics.planetary_mesh import planet_forces
+from ..physics.planetary_mesh import planet_forces, stage_forces
 from .user_functions import compiled
 
 __all__ = ["PlanetarySystem", "build_planetary", "planetary_mesh_forces", "solve_planetary"]
@@ -113,27 +113,26 @@ def build_planetary(
     for n, name in enumerate(_planet_names(layout)):
         x, y = layout.planet_centre_m(n)
         add_member(name, layout.planet, (x, y), speeds["planet"], (-wc * y, wc * x))
-    order = [nodes[k] for k in CENTRAL]
-    ref_central = np.concatenate([reference[k] for k in CENTRAL])
-    for n, name in enumerate(_planet_names(layout)):
-        ref = np.concatenate([ref_central, reference[name]])
-        G, P_s, P_r = layout.geometry(n), layout.sun_mesh, layout.ring_mesh
-        forces = compiled(planet_forces, ref, ref, G, P_s, P_r)
+    names = [*CENTRAL, *_planet_names(layout)]
+    ref = np.concatenate([reference[k] for k in names])
+    G = np.array([layout.geometry(n) for n in range(len(layout.planet_angles_rad))])
+    P_s, P_r = layout.sun_mesh, layout.ring_mesh
+    forces = compiled(stage_forces, ref, ref, G, P_s, P_r)
 
-        def planet_items(mbs, t, itemNumber, q, q_t, ref=ref, G=G, forces=forces, P_s=P_s, P_r=P_r):
-            return forces(np.asarray(q) + ref, np.asarray(q_t), G, P_s, P_r)[0]
+    def stage_items(mbs, t, itemNumber, q, q_t):
+        return forces(np.asarray(q) + ref, np.asarray(q_t), G, P_s, P_r)
 
-        mbs.AddObject(
-            ObjectGenericODE2(
-                nodeNumbers=[*order, nodes[name]],
-                massMatrix=np.zeros((12, 12)),
-                forceUserFunction=planet_items,
-                visualization=HIDDEN,
-            )
+    size = 3 * len(names)
+    mbs.AddObject(
+        ObjectGenericODE2(
+            nodeNumbers=[nodes[k] for k in names],
+            massMatrix=np.zeros((size, size)),
+            forceUserFunction=stage_items,
+            visualization=HIDDEN,
         )
-        planet_items.__name__ = f"planet_{n + 1}_forces"
+    )
     system = PlanetarySystem(SC, mbs, layout, nodes, reference)
-    system.user_functions = [planet_items]
+    system.user_functions = [stage_items]
     for name, node in nodes.items():
         system.sensors[name] = {
             kind: mbs.AddSensor(SensorNode(nodeNumber=node, outputVariableType=ovt, storeInternal=True))

@@ -44,6 +44,7 @@ __all__ = [
     "pair_deflection",
     "pair_deflection_rate",
     "planet_forces",
+    "stage_forces",
 ]
 
 
@@ -111,13 +112,14 @@ G_SIZE = 11
 def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarray, P_ring: np.ndarray):
     """Generalised forces (12) of one planet's sun mesh, ring mesh and bearing on the carrier, and the two
     normal mesh forces (N). ``q``, ``q_t``: absolute [x, y, theta] of sun, ring, carrier, planet (m, rad).
-
     The meshes are :func:`gearbody.physics.mesh.mesh_contact` on the exact deflection of
     :func:`pair_deflection` (sun mesh: sun = member 1, z1 = z_sun in ``P_sun``; ring mesh: ring = member
-    1, z1 = z_ring in ``P_ring``), the law's angle being member 1's rotation relative to the line of
-    centres plus ``G[G_ANGLE_*]``; forces -F grad(delta). The planet bearing is an isotropic spring-damper
-    between the planet centre and its point on the carrier, c_c + r_c (cos, sin)(theta_c + psi), its
-    reaction acting on the carrier at that point. Friction is not modelled here yet."""
+    1, z1 = z_ring in ``P_ring``), the law's angle being the sun's rotation relative to the line of
+    centres (theta_s - phi) and the line of centres' rotation relative to the ring (phi - theta_r), each
+    plus ``G[G_ANGLE_*]``: both grow when the sun drives counter-clockwise; forces -F grad(delta). The
+    planet bearing is an isotropic spring-damper between the planet centre and its point on the carrier,
+    c_c + r_c (cos, sin)(theta_c + psi), its reaction acting on the carrier at that point. Friction is not
+    modelled here yet."""
     f = np.zeros(12)
     phi_ref = q[8] + G[G_PSI]
     rbs, rbp, rbr = G[G_RB_SUN], G[G_RB_PLANET], G[G_RB_RING]
@@ -141,7 +143,9 @@ def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarr
         pair[k], pair_t[k] = q[3 + k], q_t[3 + k]
     d, nx, ny, phi, _ = pair_deflection(pair, rbr, rbp, True, phi_ref)
     rate = pair_deflection_rate(pair, pair_t, rbr, rbp, True)
-    F_ring = mesh_contact(q[5] - phi + G[G_ANGLE_RING], d - G[G_DELTA0_RING], rate, P_ring)[0]
+    # the ring's angle relative to the line of centres, negated: it grows as the mesh engages (carrier
+    # turning counter-clockwise in the ring), so the law's tooth counter and phase run forwards
+    F_ring = mesh_contact(phi - q[5] + G[G_ANGLE_RING], d - G[G_DELTA0_RING], rate, P_ring)[0]
     f[3] -= F_ring * nx
     f[4] -= F_ring * ny
     f[5] -= F_ring * rbr
@@ -162,3 +166,26 @@ def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarr
     f[7] -= Fy
     f[8] += rc * (s * Fx - c * Fy)
     return f, F_sun, F_ring
+
+
+@njit(cache=True)
+def stage_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarray, P_ring: np.ndarray):
+    """Generalised forces of every planet's meshes and bearing: ``q``, ``q_t`` absolute [x, y, theta] of
+    sun, ring, carrier, then planet 1..N (9 + 3 N); ``G`` one geometry row per planet (N x G_SIZE). One
+    call for the whole stage (the solver's per-call overhead, not the law, dominates one call per planet)."""
+    n = G.shape[0]
+    f = np.zeros(9 + 3 * n)
+    qk = np.empty(12)
+    qtk = np.empty(12)
+    for i in range(9):
+        qk[i], qtk[i] = q[i], q_t[i]
+    for k in range(n):
+        o = 9 + 3 * k
+        for i in range(3):
+            qk[9 + i], qtk[9 + i] = q[o + i], q_t[o + i]
+        fk = planet_forces(qk, qtk, G[k], P_sun, P_ring)[0]
+        for i in range(9):
+            f[i] += fk[i]
+        for i in range(3):
+            f[o + i] += fk[9 + i]
+    return f
