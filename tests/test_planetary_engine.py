@@ -215,3 +215,49 @@ def test_each_planets_mesh_phase_follows_from_its_position_and_the_teeth(teeth):
         lag = [(-np.angle(ck / c[0]) / (2 * math.pi)) % 1.0 for ck in c]
         for measured, want in zip(lag, delays, strict=True):
             assert min(abs(measured - want), 1 - abs(measured - want)) < 0.01, (mesh, lag, delays)
+
+
+def test_contact_ratios_of_the_sun_and_ring_meshes_by_hand():
+    """21/30/81 teeth, module 4 mm, 20 deg, standard addenda (hand: tip and base radii in mm, p_b = 11.809):
+    sun (23.63 + 30.28 - 102 sin 20) / p_b = 1.611; ring (30.28 - 42.31 + 102 sin 20) / p_b = 1.936."""
+    from gearbody.assembly.planetary_layout import contact_ratios
+    from gearbody.physics.planetary import PlanetaryGeometry
+
+    g = PlanetaryGeometry(z_sun=21, z_planet=30, z_ring=81, n_planets=3, module_m=MODULE)
+    rb = [r * math.cos(ALPHA0) for r in (42.0, 60.0, 162.0)]
+    s_s, s_p, s_r = (math.sqrt(a**2 - b**2) for a, b in zip((46.0, 64.0, 158.0), rb, strict=True))
+    p_b = math.pi * 4.0 * math.cos(ALPHA0)
+    sun, ring = contact_ratios(g)
+    assert sun == pytest.approx((s_s + s_p - 102.0 * math.sin(ALPHA0)) / p_b, rel=1e-12)
+    assert ring == pytest.approx((s_p - s_r + 102.0 * math.sin(ALPHA0)) / p_b, rel=1e-12)
+    assert sun == pytest.approx(1.611, abs=1e-3) and ring == pytest.approx(1.936, abs=1e-3)
+
+
+@pytest.mark.parametrize(
+    "teeth, offset_periods, in_phase", [((21, 30, 81), 0.5, True), ((22, 29, 80), 0.0, False)]
+)
+def test_a_layout_from_the_geometry_shares_the_load_and_carries_the_ring_sun_offset(
+    teeth, offset_periods, in_phase
+):
+    from gearbody.assembly.planetary_layout import layout_from_geometry
+    from gearbody.physics.planetary import PlanetaryGeometry
+
+    g = PlanetaryGeometry(z_sun=teeth[0], z_planet=teeth[1], z_ring=teeth[2], n_planets=3, module_m=MODULE)
+    base = _layout(3, damping=2000.0)
+    lay = layout_from_geometry(
+        g, sun=base.sun, ring=base.ring, carrier=base.carrier, planet=base.planet,
+        stiffness_single_N_per_m=(4e8, 4.5e8), stiffness_double_N_per_m=(6e8, 6.5e8),
+        damping_Ns_per_m=(2000.0, 2000.0),
+    )  # fmt: skip
+    assert all(o == (0.0, 2 * math.pi * offset_periods / teeth[2]) for o in lay.mesh_angle_offsets_rad)
+    system = build_planetary(lay, torques_Nm={"sun": 100.0})
+    forces = planetary_mesh_forces(system, solve_planetary(system, 0.05))
+    # at rest the sun's torque balance is exact; the planets share equally where their meshes sit at the
+    # same phase (in phase), within a few per mille where they do not (sequential: stiffnesses differ)
+    share = 100.0 / (3 * g.sun_base_radius_m)
+    sun = [forces[f"planet_{k}_sun_mesh_force_N"][-1] for k in (1, 2, 3)]
+    assert sum(sun) == pytest.approx(3 * share, rel=1e-6)
+    for k in (1, 2, 3):
+        tolerance = 1e-5 if in_phase else 1e-2
+        assert forces[f"planet_{k}_sun_mesh_force_N"][-1] == pytest.approx(share, rel=tolerance)
+        assert forces[f"planet_{k}_ring_mesh_force_N"][-1] == pytest.approx(share, rel=tolerance)

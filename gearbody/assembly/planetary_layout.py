@@ -30,7 +30,14 @@ from ..physics.planetary_mesh import (
     pair_deflection,
 )
 
-__all__ = ["PlanetaryLayout", "PlanetaryMember", "nominal_deflections_m", "rigid_speeds_rad_s"]
+__all__ = [
+    "PlanetaryLayout",
+    "PlanetaryMember",
+    "contact_ratios",
+    "layout_from_geometry",
+    "nominal_deflections_m",
+    "rigid_speeds_rad_s",
+]
 
 CENTRAL = ("sun", "ring", "carrier")
 
@@ -119,3 +126,80 @@ def rigid_speeds_rad_s(layout: PlanetaryLayout, sun_rad_s: float, carrier_rad_s:
     planet = carrier_rad_s - rbs / rbp * (sun_rad_s - carrier_rad_s)
     ring = carrier_rad_s + rbp / rbr * (planet - carrier_rad_s)
     return {"sun": sun_rad_s, "carrier": carrier_rad_s, "ring": ring, "planet": planet}
+
+
+def contact_ratios(geometry) -> tuple[float, float]:
+    """(sun-planet, ring-planet) transverse contact ratios of standard teeth (addendum one module):
+    external ``(sqrt(r_a1^2 - r_b1^2) + sqrt(r_a2^2 - r_b2^2) - a sin(alpha)) / p_b``, internal
+    ``(sqrt(r_ap^2 - r_bp^2) - sqrt(r_ar^2 - r_br^2) + a_r sin(alpha)) / p_b`` with the ring's tip
+    circle inside its pitch circle (r_ar = r_r - m) and a_r = r_r - r_p."""
+    g = geometry
+    alpha = g.pressure_angle_rad
+    p_b = math.pi * g.module_m * math.cos(alpha)
+    r_as = g.sun_pitch_radius_m + g.module_m
+    s_s = math.sqrt(r_as**2 - g.sun_base_radius_m**2)
+    s_p = math.sqrt(g.planet_tip_radius_m**2 - g.planet_base_radius_m**2)
+    s_r = math.sqrt(g.ring_tip_radius_m**2 - g.ring_base_radius_m**2)
+    a_s = g.carrier_radius_m
+    a_r = g.ring_pitch_radius_m - g.planet_pitch_radius_m
+    return (s_s + s_p - a_s * math.sin(alpha)) / p_b, (s_p - s_r + a_r * math.sin(alpha)) / p_b
+
+
+def layout_from_geometry(
+    geometry,
+    *,
+    sun: PlanetaryMember,
+    ring: PlanetaryMember,
+    carrier: PlanetaryMember,
+    planet: PlanetaryMember,
+    stiffness_single_N_per_m: tuple[float, float],
+    stiffness_double_N_per_m: tuple[float, float],
+    damping_Ns_per_m: tuple[float, float] = (0.0, 0.0),
+    backlash_m: tuple[float, float] = (0.0, 0.0),
+    transition_width: float = 0.0,
+) -> PlanetaryLayout:
+    """A :class:`PlanetaryLayout` from a checked :class:`gearbody.physics.planetary.PlanetaryGeometry`:
+    radii, planet angles, each mesh's contact ratio (:func:`contact_ratios`) and the ring mesh's offset of
+    half a mesh period when the planet has an even number of teeth (``planet_mesh_phases(...).ring_sun``).
+    The pairs of mesh values are (sun mesh, ring mesh); no errors, friction or faults yet."""
+    from ..physics.mesh import pack_mesh_parameters
+    from ..physics.planetary import planet_mesh_phases
+
+    g = geometry
+    eps_s, eps_r = contact_ratios(g)
+    rbs, rbp, rbr = g.sun_base_radius_m, g.planet_base_radius_m, g.ring_base_radius_m
+
+    def mesh(k: int, z1: int, r1: float, eps: float) -> np.ndarray:
+        return pack_mesh_parameters(
+            r1_m=r1,
+            r2_m=rbp,
+            z1=z1,
+            z2=g.z_planet,
+            stiffness_single_N_per_m=stiffness_single_N_per_m[k],
+            stiffness_double_N_per_m=stiffness_double_N_per_m[k],
+            contact_ratio=eps,
+            damping_Ns_per_m=damping_Ns_per_m[k],
+            backlash_m=backlash_m[k],
+            friction_coefficient=0.0,
+            pitch_point_phase=0.5,
+            pressure_angle_rad=g.pressure_angle_rad,
+            error_a=0.0,
+            error_depths_m=np.zeros(z1),
+            transition_width=transition_width,
+        )
+
+    ring_offset = 2.0 * math.pi * planet_mesh_phases(g).ring_sun / g.z_ring
+    return PlanetaryLayout(
+        sun=sun,
+        ring=ring,
+        carrier=carrier,
+        planet=planet,
+        planet_angles_rad=tuple(g.planet_angles_rad),
+        carrier_radius_m=g.carrier_radius_m,
+        base_radius_sun_m=rbs,
+        base_radius_planet_m=rbp,
+        base_radius_ring_m=rbr,
+        sun_mesh=mesh(0, g.z_sun, rbs, eps_s),
+        ring_mesh=mesh(1, g.z_ring, rbr, eps_r),
+        mesh_angle_offsets_rad=tuple((0.0, ring_offset) for _ in g.planet_angles_rad),
+    )
