@@ -6,7 +6,16 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_OK, add_out, add_set, check_out, number, scenario_overrides, usage_error
+from .common import (
+    EXIT_OK,
+    add_executor,
+    add_out,
+    add_set,
+    check_out,
+    number,
+    scenario_overrides,
+    usage_error,
+)
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -92,17 +101,7 @@ def register(sub) -> argparse.ArgumentParser:
     ca.add_argument(
         "--seed", type=number(whole=True, ge=0), default=0, metavar="S", help="optimiser seed (default 0)"
     )
-    ca.add_argument(
-        "--workers",
-        type=number(whole=True, ge=1),
-        metavar="N",
-        help="local processes (default: all cores; 1: serial)",
-    )
-    ca.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="run on a Dask cluster, e.g. tcp://host:8786 (needs: pip install gearbody[sweep])",
-    )
+    add_executor(ca)
     ca.add_argument("--force", action="store_true", help="allow more evaluations than the limit (2000)")
     ca.add_argument("--quiet", action="store_true", help="no progress and no table")
     add_out(ca, "output folder of the calibration", required=True)
@@ -115,13 +114,11 @@ def _starts(texts: list[str]) -> dict[str, float]:
 
     starts = {}
     for text in texts:
-        key, sep, value = text.partition("=")
+        key, _, value = text.partition("=")
         try:
             starts[key.strip()] = float(value)
-        except ValueError:
+        except ValueError:  # no "=" leaves value empty
             raise SweepSpecError(f"--start {text}: expected KEY=VALUE with a number") from None
-        if not sep:
-            raise SweepSpecError(f"--start {text}: expected KEY=VALUE")
     return starts
 
 

@@ -20,6 +20,7 @@ __all__ = [
     "EXIT_OK",
     "EXIT_SIMULATION",
     "EXIT_USAGE",
+    "add_executor",
     "add_out",
     "add_set",
     "check_options",
@@ -47,6 +48,25 @@ def add_set(parser: argparse.ArgumentParser, help: str) -> None:
     """``--set KEY=VALUE`` (repeatable) into ``args.overrides``."""
     parser.add_argument(
         "--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE", help=help
+    )
+
+
+MAX_WORKERS = 256
+"""Largest --workers of a study command."""
+
+
+def add_executor(parser: argparse.ArgumentParser) -> None:
+    """``--workers N`` and ``--scheduler ADDRESS``: where a study runs (gearbody.studies.executors)."""
+    parser.add_argument(
+        "--workers",
+        type=number(whole=True, ge=1, le=MAX_WORKERS),
+        metavar="N",
+        help="local processes (default: all cores; 1: serial)",
+    )
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on a Dask cluster, e.g. tcp://host:8786 (needs: pip install gearbody[sweep])",
     )
 
 

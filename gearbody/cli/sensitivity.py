@@ -6,7 +6,16 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_OK, add_out, add_set, check_out, number, scenario_overrides, usage_error
+from .common import (
+    EXIT_OK,
+    add_executor,
+    add_out,
+    add_set,
+    check_out,
+    number,
+    scenario_overrides,
+    usage_error,
+)
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -66,17 +75,7 @@ def register(sub) -> argparse.ArgumentParser:
     se.add_argument("--no-second-order", action="store_true", help="Sobol: no S2 (D + 2 runs per sample)")
     add_set(se, "fixed override of every run (as for run)")
     se.add_argument("--t-end", type=number(gt=0), metavar="SECONDS", help="simulated time of every run")
-    se.add_argument(
-        "--workers",
-        type=number(whole=True, ge=1),
-        metavar="N",
-        help="local processes (default: all cores; 1: serial)",
-    )
-    se.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="run on a Dask cluster, e.g. tcp://host:8786 (needs: pip install gearbody[sweep])",
-    )
+    add_executor(se)
     se.add_argument("--force", action="store_true", help="allow more runs than the limit (2000)")
     se.add_argument("--retry-failed", action="store_true", help="on resume, rerun the runs that failed")
     se.add_argument(

@@ -8,6 +8,7 @@ import argparse
 from .common import (
     EXIT_FAILED,
     EXIT_OK,
+    add_executor,
     add_out,
     add_set,
     check_out,
@@ -82,17 +83,7 @@ def register(sub) -> argparse.ArgumentParser:
     )
     add_set(sw, "fixed override of every case (as for run)")
     sw.add_argument("--t-end", type=number(gt=0), metavar="SECONDS", help="simulated time of every case")
-    sw.add_argument(
-        "--workers",
-        type=number(whole=True, ge=1, le=256),
-        metavar="N",
-        help="local processes (default: all cores; 1: serial)",
-    )
-    sw.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="run on a Dask cluster, e.g. tcp://host:8786 (needs: pip install gearbody[sweep])",
-    )
+    add_executor(sw)
     sw.add_argument(
         "--plot-value",
         default="kd_max_final",
