@@ -97,6 +97,12 @@ def pair_deflection_rate(
     """d(delta)/dt = grad(delta) . q_t (the gradient: r_b1 and +-r_b2 on the rotations, +n and -n on the
     centres)."""
     _, nx, ny, _, _ = pair_deflection(q, r_b1_m, r_b2_m, internal, 0.0)  # n does not depend on phi_ref
+    return _rate(nx, ny, q_t, r_b1_m, r_b2_m, internal)
+
+
+@njit(cache=True)
+def _rate(nx: float, ny: float, q_t: np.ndarray, r_b1_m: float, r_b2_m: float, internal: bool) -> float:
+    """grad(delta) . q_t from the line of action n already computed."""
     rot = r_b1_m * q_t[2] - r_b2_m * q_t[5] if internal else r_b1_m * q_t[2] + r_b2_m * q_t[5]
     return rot + nx * (q_t[0] - q_t[3]) + ny * (q_t[1] - q_t[4])
 
@@ -130,7 +136,7 @@ def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarr
         pair[k], pair[3 + k] = q[k], q[9 + k]
         pair_t[k], pair_t[3 + k] = q_t[k], q_t[9 + k]
     d, nx, ny, phi, _ = pair_deflection(pair, rbs, rbp, False, phi_ref)
-    rate = pair_deflection_rate(pair, pair_t, rbs, rbp, False)
+    rate = _rate(nx, ny, pair_t, rbs, rbp, False)
     F_sun = mesh_contact(q[2] - phi + G[G_ANGLE_SUN], d - G[G_DELTA0_SUN], rate, P_sun)[0]
     f[0] -= F_sun * nx
     f[1] -= F_sun * ny
@@ -142,7 +148,7 @@ def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarr
     for k in range(3):
         pair[k], pair_t[k] = q[3 + k], q_t[3 + k]
     d, nx, ny, phi, _ = pair_deflection(pair, rbr, rbp, True, phi_ref)
-    rate = pair_deflection_rate(pair, pair_t, rbr, rbp, True)
+    rate = _rate(nx, ny, pair_t, rbr, rbp, True)
     # the ring's angle relative to the line of centres, negated: it grows as the mesh engages (carrier
     # turning counter-clockwise in the ring), so the law's tooth counter and phase run forwards
     F_ring = mesh_contact(phi - q[5] + G[G_ANGLE_RING], d - G[G_DELTA0_RING], rate, P_ring)[0]
