@@ -16,7 +16,7 @@ from gearbody.model import load_scenario  # noqa: E402
 from gearbody.studies import SweepSpecError  # noqa: E402
 from gearbody.studies.calibration import Parameter, Target  # noqa: E402
 from gearbody.studies.scene_calibration import calibrate_scene, parse_parameter, parse_target  # noqa: E402
-from gearbody.studies.sensitivity import _scene, scene_features  # noqa: E402
+from gearbody.studies.sensitivity import read_scene, scene_features  # noqa: E402
 
 STEADY = [
     'operation.initial_state="steady"',
@@ -171,7 +171,7 @@ def test_known_stiffness_damping_and_error_are_recovered_from_a_wrong_start(tmp_
     truth = {K: 1.1e9, C: 9000.0, E: 14.0}
     overrides = ["operation.t_end_s=0.2", *STEADY]
     features = [A1, A2, "natural_frequency_hz:mode=3", "rms:signal=pinion_accel_rad_s2", "kd_std"]
-    _, base, _ = _scene("one-stage")
+    _, base, _ = read_scene("one-stage")
     measured = scene_features(truth, base, overrides, features)
     params = [
         Parameter(K, 0.8e9, 1.6e9, start=1.5e9, log=True),

@@ -41,7 +41,7 @@ from .calibration import (
 )
 from .executors import check_options, run_jobs
 from .parse import SweepSpecError, check_key
-from .sensitivity import _check_signals, _scene, evaluate_rows, scene_features
+from .sensitivity import check_feature_signals, evaluate_rows, read_scene, scene_features
 from .store import write_json, write_text
 
 __all__ = ["MAX_EVALUATIONS", "SceneCalibration", "calibrate_scene", "parse_parameter", "parse_target"]
@@ -190,7 +190,7 @@ def calibrate_scene(
             raise SweepSpecError(
                 f"override {o}: {parse_override(o)[0]} is also a --param; give it in one place"
             )
-    label, base, sha = _scene(scene)
+    label, base, sha = read_scene(scene)
     for case, extra in used.items():
         where = f"case {case!r}" if case else "the fixed overrides"
         try:
@@ -204,7 +204,7 @@ def calibrate_scene(
                 except ScenarioError as exc:
                     raise SweepSpecError(f"--param {p.key}: at {v!r} ({where}): {exc}") from None
         specs = [parse_feature(t.feature) for t in targets if t.case == case]
-        _check_signals(base, [*overrides, *extra], specs)
+        check_feature_signals(base, [*overrides, *extra], specs)
 
     features = {case: tuple(dict.fromkeys(t.feature for t in targets if t.case == case)) for case in used}
     out = Path(out)

@@ -53,9 +53,11 @@ __all__ = [
     "MissingRowsError",
     "SensitivityResult",
     "analyse_model",
+    "check_feature_signals",
     "evaluate_rows",
     "ishigami",
     "parse_key_range",
+    "read_scene",
     "run_count",
     "salib",
     "scene_features",
@@ -555,7 +557,7 @@ def scene_features(
     return evaluate_features(specs, simulate(scenario).record(freqs))
 
 
-def _scene(scene: str | Path) -> tuple[str, dict[str, Any], str]:
+def read_scene(scene: str | Path) -> tuple[str, dict[str, Any], str]:
     """(label stored in the spec, TOML data, sha256 of the file) of a scene name or TOML path."""
     from gearbody.model import ScenarioError, scene_path
     from gearbody.model.io import read_toml
@@ -613,7 +615,7 @@ def sensitivity(
     for o in overrides:
         if parse_override(o)[0] in problem:
             raise SweepSpecError(f"--set {o}: {parse_override(o)[0]} is also a --key; give it in one place")
-    label, base, sha = _scene(scene)
+    label, base, sha = read_scene(scene)
     load_scenario(dict(base), list(overrides))  # the fixed overrides alone
     for k, (lo, hi) in problem.items():
         for v in (lo, hi):
@@ -625,7 +627,7 @@ def sensitivity(
 
     def check(X: np.ndarray) -> None:  # after the options are checked, before anything is written
         _check_rows(problem, base, overrides, X)
-        _check_signals(base, overrides, parsed)
+        check_feature_signals(base, overrides, parsed)
 
     return analyse_model(
         scene_features,
@@ -651,7 +653,7 @@ PROBE_S = 0.002
 """Simulated time of the probe run that finds the signals a scene records (a few hundredths of a second)."""
 
 
-def _check_signals(base: Mapping[str, Any], overrides: Sequence[str], specs) -> None:
+def check_feature_signals(base: Mapping[str, Any], overrides: Sequence[str], specs) -> None:
     """Every signal the features read is one the scene records: a probe run of PROBE_S finds them."""
     need = {}
     for spec in specs:
