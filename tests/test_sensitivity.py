@@ -437,6 +437,16 @@ def _png_size(path):
     return struct.unpack(">II", head[16:24])
 
 
+DAMPING_ON_KD = [
+    "sensitivity",
+    "one-stage",
+    "--key",
+    "design.mesh.damping_Ns_per_m=3000:12000",
+    "--feature",
+    "kd_max",
+]
+
+
 @pytest.mark.parametrize(
     "option, message",
     [
@@ -450,15 +460,7 @@ def _png_size(path):
 def test_numeric_options_are_refused_as_typed(tmp_path, capsys, option, message):
     from gearbody.cli import main
 
-    args = [
-        "sensitivity",
-        "one-stage",
-        "--key",
-        "design.mesh.damping_Ns_per_m=3000:12000",
-        "--feature",
-        "kd_max",
-    ]
-    assert main([*args, *option, "--out", str(tmp_path / "s"), "--quiet"]) == 2
+    assert main([*DAMPING_ON_KD, *option, "--out", str(tmp_path / "s"), "--quiet"]) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "s").exists()
 
@@ -467,13 +469,5 @@ def test_an_out_that_is_a_file_is_refused_before_anything_runs(tmp_path, capsys)
     from gearbody.cli import main
 
     (tmp_path / "f").write_text("x")
-    args = [
-        "sensitivity",
-        "one-stage",
-        "--key",
-        "design.mesh.damping_Ns_per_m=3000:12000",
-        "--feature",
-        "kd_max",
-    ]
-    assert main([*args, "--out", str(tmp_path / "f"), "--quiet"]) == 2
+    assert main([*DAMPING_ON_KD, "--out", str(tmp_path / "f"), "--quiet"]) == 2
     assert "is a file, not a folder" in capsys.readouterr().err
