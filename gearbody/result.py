@@ -139,8 +139,12 @@ class Result:
             sources = KinematicSources.gear_train(f_mesh / teeth[0][0], teeth)
             lines = kinematic_lines(sources, f_max, harmonics=harmonics, sidebands=sidebands, shaft_orders=30)
             peaks = label_peaks(
-                spec, lines, tolerance_hz=1.5 * spec.resolution_hz, min_prominence_db=min_prominence_db,
-                max_peaks=max_peaks, f_max_hz=f_max,
+                spec,
+                lines,
+                tolerance_hz=1.5 * spec.resolution_hz,
+                min_prominence_db=min_prominence_db,
+                max_peaks=max_peaks,
+                f_max_hz=f_max,
             )
         return LabelledSpectrum(signal=name, spectrum=spec, peaks=peaks, f_max_hz=f_max)
 
@@ -296,7 +300,11 @@ class LabelledSpectrum:
 
         unit = "rad/s^2" if self.signal.endswith("rad_s2") else "m/s^2"
         return plot_labelled_spectrum(
-            self.spectrum, self.peaks, ax=ax, title=title or f"spectrum of {self.signal}", unit=unit,
+            self.spectrum,
+            self.peaks,
+            ax=ax,
+            title=title or f"spectrum of {self.signal}",
+            unit=unit,
             f_max_hz=self.f_max_hz,
         )
 

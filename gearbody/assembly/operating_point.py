@@ -62,7 +62,7 @@ def steady_operating_point(scenario: Scenario) -> dict[str, object]:
     load = d.machine.rated_torque_Nm * np.interp(0.0, op.load_profile.time_s, op.load_profile.fraction)
     fraction = load / d.machine.rated_torque_Nm
     forces = [fraction * scenario.stage_rated_force_N(k) for k in range(len(stages))]
-    pinion_torques = [f * st.pinion.base_radius_m for f, st in zip(forces, stages, strict=True)]
+    pinion_torques = [f * st.input_arm_m for f, st in zip(forces, stages, strict=True)]  # planetary: r_eq
     try:
         s = steady_slip(pinion_torques[0], d.motor.breakdown_torque_Nm, d.motor.breakdown_slip)
     except ValueError as exc:  # the physics' own refusal: load above the breakdown torque
@@ -72,7 +72,7 @@ def steady_operating_point(scenario: Scenario) -> dict[str, object]:
     pinion_speeds, wheel_speeds = [], []
     for st in stages:
         pinion_speeds.append(w)
-        w = w * st.pinion.base_radius_m / st.wheel.base_radius_m  # r_p w_p = r_w w_w: no deflection rate
+        w = w * st.input_arm_m / st.output_arm_m  # r_p w_p = r_w w_w: no deflection rate
         wheel_speeds.append(w)
     return {
         "load_torque_Nm": load,

@@ -35,6 +35,7 @@ __all__ = [
     "PlanetaryMember",
     "contact_ratios",
     "layout_from_geometry",
+    "layout_from_stage",
     "nominal_deflections_m",
     "rigid_speeds_rad_s",
 ]
@@ -156,20 +157,28 @@ def layout_from_geometry(
     stiffness_double_N_per_m: tuple[float, float],
     damping_Ns_per_m: tuple[float, float] = (0.0, 0.0),
     backlash_m: tuple[float, float] = (0.0, 0.0),
-    transition_width: float = 0.0,
+    transition_width: float | tuple[float, float] = 0.0,
+    contact_ratio: tuple[float | None, float | None] = (None, None),
+    pitch_point_phase: tuple[float, float] = (0.5, 0.5),
+    error_a: tuple[float, float] = (0.0, 0.0),
+    error_depths_m: tuple[np.ndarray | None, np.ndarray | None] = (None, None),
 ) -> PlanetaryLayout:
     """A :class:`PlanetaryLayout` from a checked :class:`gearbody.physics.planetary.PlanetaryGeometry`:
-    radii, planet angles, each mesh's contact ratio (:func:`contact_ratios`) and the ring mesh's offset of
-    half a mesh period when the planet has an even number of teeth (``planet_mesh_phases(...).ring_sun``).
-    The pairs of mesh values are (sun mesh, ring mesh); no errors, friction or faults yet."""
+    radii, planet angles, each mesh's contact ratio (:func:`contact_ratios` unless given) and the ring
+    mesh's offset of half a mesh period when the planet has an even number of teeth
+    (``planet_mesh_phases(...).ring_sun``). The pairs of mesh values are (sun mesh, ring mesh); the
+    error depths are per sun (ring) tooth, None for none. No friction or faults yet."""
     from ..physics.mesh import pack_mesh_parameters
     from ..physics.planetary import planet_mesh_phases
 
     g = geometry
-    eps_s, eps_r = contact_ratios(g)
+    standard = contact_ratios(g)
+    eps_s, eps_r = (standard[k] if contact_ratio[k] is None else contact_ratio[k] for k in (0, 1))
     rbs, rbp, rbr = g.sun_base_radius_m, g.planet_base_radius_m, g.ring_base_radius_m
+    widths = transition_width if isinstance(transition_width, tuple) else (transition_width,) * 2
 
     def mesh(k: int, z1: int, r1: float, eps: float) -> np.ndarray:
+        depths = np.zeros(z1) if error_depths_m[k] is None else error_depths_m[k]
         return pack_mesh_parameters(
             r1_m=r1,
             r2_m=rbp,
@@ -181,11 +190,11 @@ def layout_from_geometry(
             damping_Ns_per_m=damping_Ns_per_m[k],
             backlash_m=backlash_m[k],
             friction_coefficient=0.0,
-            pitch_point_phase=0.5,
+            pitch_point_phase=pitch_point_phase[k],
             pressure_angle_rad=g.pressure_angle_rad,
-            error_a=0.0,
-            error_depths_m=np.zeros(z1),
-            transition_width=transition_width,
+            error_a=error_a[k],
+            error_depths_m=depths,
+            transition_width=widths[k],
         )
 
     ring_offset = 2.0 * math.pi * planet_mesh_phases(g).ring_sun / g.z_ring
@@ -202,4 +211,48 @@ def layout_from_geometry(
         sun_mesh=mesh(0, g.z_sun, rbs, eps_s),
         ring_mesh=mesh(1, g.z_ring, rbr, eps_r),
         mesh_angle_offsets_rad=tuple((0.0, ring_offset) for _ in g.planet_angles_rad),
+    )
+
+
+def _member(name: str, m) -> PlanetaryMember:
+    return PlanetaryMember(
+        name,
+        m.mass_kg,
+        m.inertia_kg_m2,
+        m.bearing_stiffness_N_per_m,
+        m.bearing_damping_Ns_per_m,
+        m.torsion_stiffness_Nm_per_rad,
+        m.torsion_damping_Nms_per_rad,
+    )
+
+
+def layout_from_stage(stage, stage_index: int, seed: int) -> PlanetaryLayout:
+    """The :class:`PlanetaryLayout` of a scenario's planetary stage (:class:`gearbody.model.planetary.
+    PlanetaryStage`, 0-based ``stage_index`` in power-flow order): members, meshes, error modes with the
+    random tooth errors of ``seed`` (docs/planetary.md, "The stage in a drive")."""
+    from ..physics.error_mode import planetary_tooth_error_depths_m
+
+    meshes = (stage.sun_mesh, stage.ring_mesh)
+    modes = {"sun": stage.sun_error_mode, "ring": stage.ring_error_mode}
+    depths = tuple(
+        planetary_tooth_error_depths_m(
+            modes[m].e_um, modes[m].r, getattr(stage, m).teeth, seed, stage_index, m
+        )
+        for m in ("sun", "ring")
+    )
+    return layout_from_geometry(
+        stage.geometry,
+        sun=_member("sun", stage.sun),
+        ring=_member("ring", stage.ring),
+        carrier=_member("carrier", stage.carrier),
+        planet=_member("planet", stage.planet),
+        stiffness_single_N_per_m=tuple(m.stiffness_single_N_per_m for m in meshes),
+        stiffness_double_N_per_m=tuple(m.stiffness_double_N_per_m for m in meshes),
+        damping_Ns_per_m=tuple(m.damping_Ns_per_m for m in meshes),
+        backlash_m=tuple(m.backlash_um * 1e-6 for m in meshes),
+        transition_width=tuple(m.transition_width for m in meshes),
+        contact_ratio=tuple(m.contact_ratio for m in meshes),
+        pitch_point_phase=tuple(m.pitch_point_phase for m in meshes),
+        error_a=(modes["sun"].a, modes["ring"].a),
+        error_depths_m=depths,
     )

@@ -88,6 +88,8 @@ def coordinate_frequencies(scenario: Scenario) -> list[CoordinateFrequency]:
                 "design.mesh.damping_Ns_per_m",
             )
         ]
+    if scenario.has_planetary:
+        return _compound_frequencies(scenario)
     layout = torsional_layout(scenario)
     keys = _inertia_keys(scenario)
     n = len(layout.inertias)
@@ -141,6 +143,84 @@ def coordinate_frequencies(scenario: Scenario) -> list[CoordinateFrequency]:
         name = f"{body.name}_{'xy'[d]}"
         out.append(coordinate(name, keys[name], body.lateral.mass_kg, k, lateral_damping[i, d]))
     return out
+
+
+def _compound_frequencies(scenario: Scenario) -> list[CoordinateFrequency]:
+    """The coordinates of a drive with planetary stages: shafts and parallel meshes as for trains, a
+    planetary stage's K_ii and C_ii from its force law at the nominal assembly (finite differences of
+    :func:`gearbody.physics.planetary_mesh.stage_forces` plus the supports)."""
+    import numpy as np
+
+    from ..physics.planetary_mesh import stage_forces
+    from .compound import compound_layout
+
+    layout = compound_layout(scenario)
+    n = len(layout.dof_names)
+    K, C = np.zeros(n), np.zeros(n)
+    mass, keys = np.zeros(n), [""] * n
+    sources: list[str] = ["" for _ in range(n)]
+    mass[0], keys[0] = scenario.design.motor.inertia_kg_m2, "design.motor.inertia_kg_m2"
+    mass[-1], keys[-1] = scenario.design.machine.inertia_kg_m2, "design.machine.inertia_kg_m2"
+    mo = scenario.design.motor
+    C[0] = viscous_equivalent_Nms(mo.breakdown_torque_Nm, mo.breakdown_slip, mo.synchronous_speed_rad_s)
+    sources[0] = "the motor's slip characteristic (design.motor)"
+    for s, sh in enumerate(layout.shafts):
+        for i in (sh.i, sh.j):
+            K[i] += sh.stiffness_Nm_per_rad
+            C[i] += sh.damping_Nms_per_rad
+            sources[i] = sources[i] or f"design.shafts.{s + 1}.damping_Nms_per_rad"
+    for m in layout.meshes:
+        st = scenario.stages[m.stage]
+        k, c = mean_stiffness_N_per_m(m.parameters), st.mesh.damping_Ns_per_m
+        for i, gear in ((m.pinion, st.pinion), (m.wheel, st.wheel)):
+            K[i] += k * gear.base_radius_m**2
+            C[i] += c * gear.base_radius_m**2
+            mass[i], keys[i] = (
+                gear.inertia_kg_m2,
+                stage_key(m.stage, "pinion" if gear is st.pinion else "wheel"),
+            )
+            keys[i] += ".inertia_kg_m2"
+            sources[i] = sources[i] or stage_key(m.stage, "mesh") + ".damping_Ns_per_m"
+    for link in layout.planetary:
+        ref, G = link.reference(), link.geometry_rows()
+        Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
+        zero = np.zeros(link.size)
+        members = (*link.layout.members, *([link.layout.planet] * (len(link.names) - 3)))
+        for j in range(link.size):
+            h = 1e-9 if j % 3 < 2 else 1e-9 / link.layout.carrier_radius_m
+            e = np.zeros(link.size)
+            e[j] = h
+            K[link.first + j] -= (
+                stage_forces(ref + e, zero, G, Ps, Pr)[j] - stage_forces(ref - e, zero, G, Ps, Pr)[j]
+            ) / (2 * h)
+            C[link.first + j] -= (
+                stage_forces(ref, e, G, Ps, Pr)[j] - stage_forces(ref, -e, G, Ps, Pr)[j]
+            ) / (2 * h)
+            member = members[j // 3]
+            name = member.name if j < 9 else "planet"
+            keys[link.first + j] = stage_key(link.stage, name) + (
+                ".mass_kg" if j % 3 < 2 else ".inertia_kg_m2"
+            )
+            mass[link.first + j] = member.mass_kg if j % 3 < 2 else member.inertia_kg_m2
+            if j < 9:
+                K[link.first + j] += (
+                    member.bearing_stiffness_N_per_m
+                    if j % 3 < 2
+                    else (member.torsion_stiffness_Nm_per_rad or 0.0)
+                )
+            sources[link.first + j] = sources[link.first + j] or stage_key(link.stage, "sun_mesh / ring_mesh")
+    return [
+        CoordinateFrequency(
+            layout.dof_names[i],
+            math.sqrt(max(K[i], 0.0) / mass[i]) / (2 * math.pi),
+            keys[i],
+            float(mass[i]),
+            float(K[i]),
+            float(C[i]),
+            sources[i],
+        )
+        for i in range(n)
+    ]
 
 
 def check_resolved_modes(scenario: Scenario) -> None:

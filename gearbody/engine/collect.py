@@ -15,6 +15,7 @@ from ..assembly import gear_names, mesh_parameters_from_scenario, pack_drive_par
 from ..errors import SimulationError
 from ..model import Scenario, budget, scenario_to_dict
 from ..model.params import stage_key
+from ..model.planetary import PlanetaryStage
 from ..physics import load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
 from ..physics.lateral import mesh_directions
@@ -22,6 +23,7 @@ from ..physics.mesh import mesh_contact_series, mesh_phase_series
 from ..result import Result
 from ..version import __version__
 from .build import BuiltSystem
+from .planetary_signals import planetary_jump_times, planetary_signals, stage_input_name
 from .sampling import OVERSAMPLING, CubicHermite, is_band_limited, mesh_jump_times
 
 __all__ = ["collect"]
@@ -94,26 +96,49 @@ def collect(scenario: Scenario, built: BuiltSystem) -> Result:
         "output_rate_hz": rate,
         "dof_names": built.dof_names,
         "rated_mesh_force_N": scenario.rated_mesh_force_N,
-        "pinion_teeth": scenario.stages[0].pinion.teeth,
-        "wheel_teeth": scenario.stages[0].wheel.teeth,
-        "stages": [
-            {
-                "pinion_teeth": st.pinion.teeth,
-                "wheel_teeth": st.wheel.teeth,
-                "rated_mesh_force_N": scenario.stage_rated_force_N(k),
-            }
-            for k, st in enumerate(scenario.stages)
-        ],
+        **_first_stage_teeth(scenario.stages[0]),
+        "stages": [_stage_meta(scenario, k) for k in range(len(scenario.stages))],
         "sources": list(scenario.meta.sources),
         "solver_statistics": stats,
     }
     return Result(time_s=t, signals=signals, meta=meta)
 
 
+def _first_stage_teeth(st) -> dict[str, int]:
+    """pinion_teeth / wheel_teeth of a parallel first stage (a planetary one has its own in 'stages')."""
+    if isinstance(st, PlanetaryStage):
+        return {}
+    return {"pinion_teeth": st.pinion.teeth, "wheel_teeth": st.wheel.teeth}
+
+
+def _stage_meta(scenario: Scenario, k: int) -> dict:
+    st = scenario.stages[k]
+    if isinstance(st, PlanetaryStage):
+        return {
+            "type": "planetary",
+            "sun_teeth": st.sun.teeth,
+            "planet_teeth": st.planet.teeth,
+            "ring_teeth": st.ring.teeth,
+            "planets": st.planets,
+            "planet_angles_deg": [math.degrees(a) for a in st.geometry.planet_angles_rad],
+            "input": st.input,
+            "output": st.output,
+            "fixed": st.fixed,
+            "rated_mesh_force_N": scenario.stage_rated_force_N(k),
+        }
+    return {
+        "pinion_teeth": st.pinion.teeth,
+        "wheel_teeth": st.wheel.teeth,
+        "rated_mesh_force_N": scenario.stage_rated_force_N(k),
+    }
+
+
 def _point_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> dict[str, np.ndarray]:
     signals = _torsional_signals(scenario, names, t, q, v, a, drive_torques=drive_torques)
     if scenario.is_lateral:
         signals.update(_lateral_signals(scenario, names, q, v, a, signals))
+    if scenario.has_planetary:
+        signals.update(planetary_signals(scenario, names, q, v, a))
     return signals
 
 
@@ -124,17 +149,16 @@ def _oversampling(scenario: Scenario, built: BuiltSystem, v_steps: np.ndarray) -
     run from the expected speeds; checked here with the measured ones)."""
     M, stage = OVERSAMPLING, None
     for k, st in enumerate(scenario.stages):
-        w = st.mesh.transition_width
+        w = st.transition_width
         if w > 0:
-            name = gear_names(k)[0]
-            row = built.dof_names.index(name)
-            f_mesh_hz = st.pinion.teeth * float(np.max(np.abs(v_steps[row]))) / (2 * math.pi)
+            row = built.dof_names.index(stage_input_name(scenario, k))
+            f_mesh_hz = st.mesh_frequency_hz(float(np.max(np.abs(v_steps[row]))))
             m = budget.oversampling(f_mesh_hz, w, scenario.solver.output_rate_hz)
             if m > M:
                 M, stage = m, k
     need, limit = budget.output_memory_bytes(scenario, M), budget.memory_limit_bytes(scenario)
     if stage is not None and need > limit:
-        w = scenario.stages[stage].mesh.transition_width
+        w = scenario.stages[stage].transition_width
         raise SimulationError(
             f"stage {stage + 1}: the pinion ran faster than expected, and resolving its mesh's "
             f"transition_width = {w:g} needs {M} fine points per output sample (~{need / 2**20:.4g} MiB), "
@@ -152,8 +176,11 @@ def _band_limited_signals(scenario, names, t_fine, q, v, a, M=OVERSAMPLING) -> d
     fine = _point_signals(scenario, names, t_fine, q, v, a, drive_torques=False)
     t = t_fine[::M]
     jumps = []
-    for k in range(len(scenario.stages)):
+    for k, st in enumerate(scenario.stages):
         prefix = "" if k == 0 else f"stage_{k + 1}_"
+        if isinstance(st, PlanetaryStage):
+            jumps += planetary_jump_times(scenario, k, names, t_fine, q, v)
+            continue
         angle = fine[f"{gear_names(k)[0]}_angle_rad"]
         delta = fine[prefix + "mesh_deflection_m"]
         jumps.append(mesh_jump_times(t_fine, angle, delta, mesh_parameters_from_scenario(scenario, k)))
@@ -207,6 +234,8 @@ def _torsional_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> di
     # Stage 1's mesh signals carry the plain names (mesh_force_N, kd, ...); later stages are prefixed
     # stage_2_, stage_3_, ... and their K_d is relative to their own rated force.
     for k, st in enumerate(scenario.stages):
+        if isinstance(st, PlanetaryStage):
+            continue  # planetary_signals
         pname, wname = gear_names(k)
         ip, iw = names.index(pname), names.index(wname)
         r1, r2 = st.pinion.base_radius_m, st.wheel.base_radius_m
@@ -231,7 +260,7 @@ def _lateral_signals(scenario, names, q, v, a, signals) -> dict[str, np.ndarray]
     """Centre motion, bearing force to the housing and housing acceleration of every lateral gear
     (docs/scenario.md, 'Signals'): a fixed direction passes the mesh force component on."""
     out = {}
-    for k, st in enumerate(scenario.stages):
+    for k, st in enumerate(scenario.stages):  # lateral gears are never combined with planetary stages
         prefix = "" if k == 0 else f"stage_{k + 1}_"
         F, T = signals[prefix + "mesh_force_N"], signals[prefix + "friction_force_N"]
         n, m, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
@@ -272,4 +301,3 @@ def _muller_signals(scenario, t, x, xd, xdd) -> dict[str, np.ndarray]:
     out["load_torque_Nm"] = np.array([load_torque_at(tk, D) for tk in t])
     out["mesh_frequency_hz"] = np.gradient(theta, t) * scenario.stages[0].pinion.teeth / (2 * math.pi)
     return out
-

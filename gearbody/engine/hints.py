@@ -30,10 +30,15 @@ def _softest_stiffness_N_per_m(scenario: Scenario, stage: int) -> float:
     return mean_stiffness_N_per_m(mesh_parameters_from_scenario(scenario, stage))
 
 
+def _parallel(scenario: Scenario) -> list[tuple[int, object]]:
+    """(index, stage) of the parallel stages (a planetary stage has its own meshes, no pinion)."""
+    return [(k, st) for k, st in enumerate(scenario.stages) if hasattr(st, "pinion")]
+
+
 def _zero_factor_teeth(scenario: Scenario) -> list[str]:
     return [
         f"{stage_key(k, 'damaged_teeth')} ({t.gear} tooth {t.tooth})"
-        for k, st in enumerate(scenario.stages)
+        for k, st in _parallel(scenario)
         for t in st.damaged_teeth
         if t.stiffness_factor == 0
     ]
@@ -42,6 +47,16 @@ def _zero_factor_teeth(scenario: Scenario) -> list[str]:
 def _jumping_meshes(scenario: Scenario) -> list[str]:
     out = []
     for k, st in enumerate(scenario.stages):
+        if not hasattr(st, "pinion"):  # planetary: its sun and ring meshes
+            for name in ("sun_mesh", "ring_mesh"):
+                m = getattr(st, name)
+                lo, hi = sorted((m.stiffness_single_N_per_m, m.stiffness_double_N_per_m))
+                if m.transition_width == 0 and hi > STIFFNESS_JUMP_RATIO * lo:
+                    out.append(
+                        f"{stage_key(k, name)}.stiffness_single_N_per_m / stiffness_double_N_per_m "
+                        f"({m.stiffness_single_N_per_m:.3g} / {m.stiffness_double_N_per_m:.3g} N/m)"
+                    )
+            continue
         m = st.mesh
         if m.stiffness_profile == "contact-ratio" and m.transition_width == 0:
             lo, hi = sorted((m.stiffness_single_N_per_m, m.stiffness_double_N_per_m))
@@ -72,14 +87,12 @@ def stall_hint(scenario: Scenario) -> str:
 
 def divergence_hint(scenario: Scenario) -> str:
     """Hint of a diverged run: a mesh that cannot carry the load, else the usual suspects."""
-    for k, st in enumerate(scenario.stages):
+    for k, st in _parallel(scenario):
         p_b_m = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
         cause = _mesh_cause(scenario, k, 0.1 * p_b_m)
         if cause:
             return cause
-    return (
-        "check stiffness, inertia and load values, or tighten solver tolerances / lower solver.max_step_s"
-    )
+    return "check stiffness, inertia and load values, or tighten solver tolerances / lower solver.max_step_s"
 
 
 def _mesh_cause(scenario: Scenario, stage: int, limit_m: float) -> str:

@@ -22,12 +22,14 @@ from ..assembly import (
     static_lateral_displacements_m,
     torsional_layout,
 )
+from ..assembly.compound import compound_initial_state, compound_layout
 from ..errors import GearbodyError, SimulationError
 from ..model import Scenario
 from ..model.budget import memory_limit_bytes
 from ..result import Result
 from .build import BuiltSystem, build_muller, build_torsional
 from .collect import collect
+from .compound import build_compound
 from .hints import divergence_hint, mesh_range_hint, stall_hint
 
 SOLVER_TYPES = {
@@ -66,6 +68,10 @@ def solver_settings(scenario: Scenario) -> exu.SimulationSettings:
 
 def build(scenario: Scenario) -> tuple[BuiltSystem, np.ndarray, np.ndarray]:
     """Exudyn system of a scenario at its initial state (an infeasible start raises InputError)."""
+    if scenario.has_planetary:
+        layout = compound_layout(scenario)
+        q0, v0 = compound_initial_state(scenario, layout)
+        return build_compound(layout, q0, v0), q0, v0
     q0, v0 = initial_state(scenario)
     if scenario.meta.topology == "muller":
         return build_muller(scenario, q0, v0), q0, v0
@@ -155,6 +161,9 @@ teeth in mesh, phase from the pinion angle) means nothing once the gears have mo
 
 def _check_mesh_range(scenario: Scenario, result: Result) -> None:
     for k, st in enumerate(scenario.stages):
+        if not hasattr(st, "pinion"):
+            _check_planetary_mesh_range(k, st, result)
+            continue
         prefix = "" if k == 0 else f"stage_{k + 1}_"
         delta = np.abs(result[prefix + "mesh_deflection_m"])
         p_b = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
@@ -167,6 +176,25 @@ def _check_mesh_range(scenario: Scenario, result: Result) -> None:
                 f"({p_b * 1e3:.3g} mm): the lumped mesh model is outside its range (the gears ran "
                 f"through each other). Hint: {hint}"
             )
+
+
+def _check_planetary_mesh_range(k: int, st, result: Result) -> None:
+    """Every planet mesh of planetary stage k within MAX_DEFLECTION_BASE_PITCH of the base pitch."""
+    prefix = "" if k == 0 else f"stage_{k + 1}_"
+    p_b = math.pi * st.module_mm * 1e-3 * math.cos(math.radians(st.pressure_angle_deg))
+    limit = MAX_DEFLECTION_BASE_PITCH * p_b
+    for n in range(st.planets):
+        for mesh in ("sun", "ring"):
+            delta = np.abs(result[f"{prefix}planet_{n + 1}_{mesh}_mesh_deflection_m"])
+            if delta.max() > limit:
+                m = int(np.argmax(delta > limit))
+                raise SimulationError(
+                    f"stage {k + 1}, planet {n + 1}: the {mesh} mesh deflection reached "
+                    f"{delta[m] * 1e3:.3g} mm at t = {result.time_s[m]:.6g} s, more than "
+                    f"{MAX_DEFLECTION_BASE_PITCH:g} of the base pitch ({p_b * 1e3:.3g} mm): the lumped "
+                    f"mesh is outside its range. Hint: check the load, the {mesh}_mesh stiffness and the "
+                    "members' bearing stiffnesses"
+                )
 
 
 __all__ = ["SimulationError", "build", "simulate", "solver_settings", "mesh_frequency_hz"]

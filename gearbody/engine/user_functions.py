@@ -95,7 +95,6 @@ def resident_memory_bytes() -> int:
         return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
-
 class StallWatchdog:
     """Rides on the drive's force function, which every step attempt evaluates (no pre-step Python call
     per attempt): every CHECK_CALLS calls it checks the watched speed for divergence, the wall-time

@@ -59,8 +59,12 @@ def coordinates(scenario: Scenario) -> int:
     """Coordinates of the simulated model (rotations and free gear-centre translations)."""
     if scenario.meta.topology == "muller":
         return 1
-    rotations = 2 if scenario.meta.topology == "two-wheel" else 2 + 2 * len(scenario.stages)
-    return rotations + sum(len(g.free_directions) for st in scenario.stages for g in (st.pinion, st.wheel))
+    parallel = scenario.parallel_stages
+    rotations = 2 if scenario.meta.topology == "two-wheel" else 2 + 2 * len(parallel)
+    planetary = sum(st.coordinate_count for st in scenario.stages if st not in parallel)
+    return (
+        rotations + planetary + sum(len(g.free_directions) for st in parallel for g in (st.pinion, st.wheel))
+    )
 
 
 def signal_count(scenario: Scenario) -> int:
@@ -68,10 +72,11 @@ def signal_count(scenario: Scenario) -> int:
     bearing and housing signals per lateral gear (13 for Muller's model)."""
     if scenario.meta.topology == "muller":
         return 13
-    gears = [g for st in scenario.stages for g in (st.pinion, st.wheel)]
+    gears = [g for st in scenario.parallel_stages for g in (st.pinion, st.wheel)]
     rotations = coordinates(scenario) - sum(len(g.free_directions) for g in gears)
     lateral = sum(3 * len(g.free_directions) + 4 for g in gears if g.lateral != "none")
-    return 3 * rotations + 9 * len(scenario.stages) + 2 + lateral
+    meshes = len(gears) // 2 + sum(2 * st.planets for st in scenario.stages if hasattr(st, "planets"))
+    return 3 * rotations + 9 * meshes + 2 + lateral
 
 
 def is_band_limited(scenario: Scenario) -> bool:
@@ -122,8 +127,7 @@ def estimate(scenario: Scenario) -> Estimate:
     M, stage = OVERSAMPLING, None
     if is_band_limited(scenario):
         for k, (st, w_p) in enumerate(zip(scenario.stages, _pinion_speeds_rad_s(scenario), strict=True)):
-            f_mesh_hz = st.pinion.teeth * w_p / (2 * math.pi)
-            m = oversampling(f_mesh_hz, st.mesh.transition_width, sv.output_rate_hz)
+            m = oversampling(st.mesh_frequency_hz(w_p), st.transition_width, sv.output_rate_hz)
             if m > M:
                 M, stage = m, k
     min_steps = t_end / sv.max_step_s
@@ -145,9 +149,8 @@ def check_resources(scenario: Scenario) -> None:
     if est.total_bytes <= limit:
         return
     sv, t_end = scenario.solver, scenario.operation.t_end_s
-    budget = (
-        f"the memory budget solver.memory_limit_MiB = {limit / 2**20:g}"
-        + (" (default)" if sv.memory_limit_MiB is None else "")
+    budget = f"the memory budget solver.memory_limit_MiB = {limit / 2**20:g}" + (
+        " (default)" if sv.memory_limit_MiB is None else ""
     )
     if est.steps_bytes >= est.output_bytes:
         raise ScenarioError(
@@ -157,7 +160,7 @@ def check_resources(scenario: Scenario) -> None:
         )
     if est.oversampling_stage is not None:
         k = est.oversampling_stage
-        w = scenario.stages[k].mesh.transition_width
+        w = scenario.stages[k].transition_width
         raise ScenarioError(
             f"{stage_key(k, 'mesh')}.transition_width = {w:g}: resolving a transition of {w:g} mesh "
             f"periods needs {float(est.oversampling):.3g} fine points per output sample, {est.samples} "

@@ -191,6 +191,8 @@ def _convert(value: Any, tp: Any, ctx: _Ctx, meta: typing.Mapping[str, Any]) -> 
         args = [a for a in get_args(tp) if a is not type(None)]
         if value is None:
             return None
+        if len(args) > 1 and all(dataclasses.is_dataclass(a) for a in args):
+            return _convert_variant(value, args, ctx)
         return _convert(value, args[0], ctx, meta)
     if tp is dict or origin is dict:
         if not isinstance(value, dict):
@@ -235,6 +237,23 @@ def _convert(value: Any, tp: Any, ctx: _Ctx, meta: typing.Mapping[str, Any]) -> 
     if tp in (int, float) and not _in_range(value, meta):
         ctx.fail(value, f"must be {describe_range(meta)}")
     return value
+
+
+def _convert_variant(value: Any, kinds: list[type], ctx: _Ctx) -> Any:
+    """A table that is one of several node types, told apart by its ``type`` key (each type's ``KIND``;
+    the first type's tables may leave it out: a design.stages item is parallel unless it says
+    ``type = "planetary"``). A type without a ``type`` field takes the key only as a label."""
+    if not isinstance(value, dict):
+        ctx.fail(value, f"must be a table of {_type_name(kinds[0])} keys")
+    by_kind = {getattr(k, "KIND", _type_name(k)): k for k in kinds}
+    kind = value.get("type", getattr(kinds[0], "KIND", None))
+    if kind not in by_kind:
+        meta = {"choices": tuple(by_kind)}
+        _convert(kind, str, ctx.child("type"), meta)  # names the key, the value and the choices
+    cls = by_kind[kind]
+    if "type" in value and "type" not in {f.name for f in dataclasses.fields(cls)}:
+        value = {k: v for k, v in value.items() if k != "type"}
+    return _from_dict(cls, value, ctx)
 
 
 def _from_dict(cls: type, data: typing.Mapping[str, Any], ctx: _Ctx) -> Any:

@@ -192,10 +192,15 @@ def resolve_design(design):
     damaged teeth checked against the stiffness profile they need. Pure: returns a new Design."""
     stages = []
     for k, st in enumerate(design.stages):
+        if not hasattr(st, "pinion"):  # a planetary stage: its geometry is its own (checked when built)
+            stages.append(st)
+            continue
         p, w, m = resolve_stage_geometry(st.pinion, st.wheel, st.mesh, stage_key(k, "mesh."))
         stages.append(dataclasses.replace(st, pinion=p, wheel=w, mesh=m))
     design = dataclasses.replace(design, stages=tuple(stages))
     for k, st in enumerate(design.stages):
+        if not hasattr(st, "pinion"):
+            continue
         where = stage_key(k, "mesh.")
         if st.mesh.stiffness_profile == "iso-6336-b":
             mesh = resolve_iso_stiffness(

@@ -15,7 +15,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 from .budget import check_resources
 from .components import Gear, Machine, Motor, Shaft
@@ -23,6 +23,7 @@ from .faults import DamagedTooth, Eccentricity, ErrorMode, PittedTooth
 from .mesh import Mesh
 from .operation import Operation
 from .params import Node, ScenarioError, param, stage_key
+from .planetary import PlanetaryStage
 from .resolve import resolve_design
 
 TOPOLOGIES = ("muller", "two-wheel", "train")
@@ -45,6 +46,7 @@ class Meta(Node):
 class Stage(Node):
     """One parallel-axis gear stage: its gears, mesh, error mode and tooth faults."""
 
+    KIND: ClassVar[str] = "parallel"  # a design.stages item without ``type``, or type = "parallel"
     pinion: Gear
     wheel: Gear
     mesh: Mesh = param(default_factory=Mesh)
@@ -58,23 +60,45 @@ class Stage(Node):
         """z2 / z1."""
         return self.wheel.teeth / self.pinion.teeth
 
+    def mesh_frequency_hz(self, input_speed_rad_s: float) -> float:
+        """z1 times the pinion's speed in revolutions per second."""
+        return self.pinion.teeth * input_speed_rad_s / (2 * math.pi)
+
+    @property
+    def transition_width(self) -> float:
+        """The mesh's transition width."""
+        return self.mesh.transition_width
+
+    @property
+    def input_arm_m(self) -> float:
+        """The pinion's base radius: torque in per unit mesh force (as a planetary stage's r_eq)."""
+        return self.pinion.base_radius_m
+
+    @property
+    def output_arm_m(self) -> float:
+        """The wheel's base radius: torque out per unit mesh force."""
+        return self.wheel.base_radius_m
+
 
 @dataclass(frozen=True, kw_only=True)
 class Design(Node):
     motor: Motor
     machine: Machine
-    stages: tuple[Stage, ...] = param(doc="gear stages in power-flow order (numbered from 1 in keys)")
+    stages: tuple[Stage | PlanetaryStage, ...] = param(
+        doc="gear stages in power-flow order (numbered from 1 in keys): parallel, or type = 'planetary'"
+    )
     shafts: tuple[Shaft, ...] = param(
         (), doc="train: motor->stage 1, stage s->s+1, ..., last stage->machine (two-wheel, muller: none)"
     )
 
     def stage_rated_force_N(self, stage: int) -> float:
         """F_rated,s: the rated machine torque passed upstream through the base radii,
-        F_N = M_rated / r_w,N and F_s = F_s+1 r_p,s+1 / r_w,s (static equilibrium, no friction)."""
+        F_N = M_rated / r_w,N and F_s = F_s+1 r_p,s+1 / r_w,s (static equilibrium, no friction); a
+        planetary stage's torque arms r_eq in place of r_p and r_w (its F_rated is per planet mesh)."""
         stages = self.stages
-        force = self.machine.rated_torque_Nm / stages[-1].wheel.base_radius_m
+        force = self.machine.rated_torque_Nm / stages[-1].output_arm_m
         for k in range(len(stages) - 1, stage, -1):
-            force *= stages[k].pinion.base_radius_m / stages[k - 1].wheel.base_radius_m
+            force *= stages[k].input_arm_m / stages[k - 1].output_arm_m
         return force
 
 
@@ -211,8 +235,13 @@ class Scenario(Node):
             )
         _check_topology(self.meta.topology, self.design)
         for k, stage in enumerate(self.stages):
-            _check_stage(k, stage)
-        if self.meta.topology == "train":
+            if isinstance(stage, PlanetaryStage):
+                _check_planetary_in_drive(k, self)
+            else:
+                _check_stage(k, stage)
+        if self.has_planetary:
+            pass  # the turning sense of each member is the stage's own (docs/planetary.md)
+        elif self.meta.topology == "train":
             _check_turning_senses(self.stages)
         else:
             for name in ("pinion", "wheel"):
@@ -241,8 +270,18 @@ class Scenario(Node):
 
     @property
     def is_lateral(self) -> bool:
-        """True when any gear moves laterally on its bearing."""
-        return any(g.lateral != "none" for st in self.stages for g in (st.pinion, st.wheel))
+        """True when any gear of a parallel stage moves laterally on its bearing."""
+        return any(g.lateral != "none" for st in self.parallel_stages for g in (st.pinion, st.wheel))
+
+    @property
+    def has_planetary(self) -> bool:
+        """True when any stage is planetary."""
+        return any(isinstance(st, PlanetaryStage) for st in self.stages)
+
+    @property
+    def parallel_stages(self) -> tuple[Stage, ...]:
+        """The parallel stages (every stage of a drive without planetary ones)."""
+        return tuple(st for st in self.stages if not isinstance(st, PlanetaryStage))
 
     @property
     def gear_ratio(self) -> float:
@@ -257,6 +296,25 @@ class Scenario(Node):
     def rated_mesh_force_N(self) -> float:
         """F_rated of the first stage."""
         return self.stage_rated_force_N(0)
+
+
+def _check_planetary_in_drive(k: int, scenario: Scenario) -> None:
+    """What a drive with a planetary stage cannot have yet (refused, never ignored)."""
+    if scenario.meta.topology != "train":
+        raise ScenarioError(
+            f"{stage_key(k, 'type')} = 'planetary': only topology 'train' has planetary stages, "
+            f"got {scenario.meta.topology!r}"
+        )
+    if scenario.condition.friction_coefficient > 0:
+        raise ScenarioError(
+            f"condition.friction_coefficient = {scenario.condition.friction_coefficient:g}: friction is not "
+            "modelled in planetary meshes yet; a drive with a planetary stage needs 0"
+        )
+    if scenario.is_lateral:
+        raise ScenarioError(
+            f"{stage_key(k, 'type')} = 'planetary': parallel stages on lateral bearings are not yet "
+            "combined with planetary stages; set their gears' lateral = 'none'"
+        )
 
 
 def _check_topology(topology: str, design: Design) -> None:

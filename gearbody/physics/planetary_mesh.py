@@ -44,6 +44,8 @@ __all__ = [
     "pair_deflection",
     "pair_deflection_rate",
     "planet_forces",
+    "planet_mesh_states",
+    "stage_mesh_series",
     "stage_forces",
 ]
 
@@ -115,6 +117,33 @@ G_SIZE = 11
 
 
 @njit(cache=True)
+def planet_mesh_states(q: np.ndarray, q_t: np.ndarray, G: np.ndarray):
+    """The two meshes of one planet (``q``, ``q_t`` as in :func:`planet_forces`): for the sun mesh and
+    then the ring mesh, the mesh law's angle, the deflection from the nominal assembly, its rate and the
+    line of action (n_x, n_y): ``(a_s, d_s, v_s, nx_s, ny_s, a_r, d_r, v_r, nx_r, ny_r)``."""
+    phi_ref = q[8] + G[G_PSI]
+    rbs, rbp, rbr = G[G_RB_SUN], G[G_RB_PLANET], G[G_RB_RING]
+    pair = np.empty(6)
+    pair_t = np.empty(6)
+    # sun mesh: sun (0..2) and planet (9..11)
+    for k in range(3):
+        pair[k], pair[3 + k] = q[k], q[9 + k]
+        pair_t[k], pair_t[3 + k] = q_t[k], q_t[9 + k]
+    d, nx_s, ny_s, phi, _ = pair_deflection(pair, rbs, rbp, False, phi_ref)
+    rate_s = _rate(nx_s, ny_s, pair_t, rbs, rbp, False)
+    angle_s, delta_s = q[2] - phi + G[G_ANGLE_SUN], d - G[G_DELTA0_SUN]
+    # ring mesh: ring (3..5) and planet
+    for k in range(3):
+        pair[k], pair_t[k] = q[3 + k], q_t[3 + k]
+    d, nx_r, ny_r, phi, _ = pair_deflection(pair, rbr, rbp, True, phi_ref)
+    rate_r = _rate(nx_r, ny_r, pair_t, rbr, rbp, True)
+    # the ring's angle relative to the line of centres, negated: it grows as the mesh engages (carrier
+    # turning counter-clockwise in the ring), so the law's tooth counter and phase run forwards
+    angle_r, delta_r = phi - q[5] + G[G_ANGLE_RING], d - G[G_DELTA0_RING]
+    return angle_s, delta_s, rate_s, nx_s, ny_s, angle_r, delta_r, rate_r, nx_r, ny_r
+
+
+@njit(cache=True)
 def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarray, P_ring: np.ndarray):
     """Generalised forces (12) of one planet's sun mesh, ring mesh and bearing on the carrier, and the two
     normal mesh forces (N). ``q``, ``q_t``: absolute [x, y, theta] of sun, ring, carrier, planet (m, rad).
@@ -129,34 +158,20 @@ def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarr
     f = np.zeros(12)
     phi_ref = q[8] + G[G_PSI]
     rbs, rbp, rbr = G[G_RB_SUN], G[G_RB_PLANET], G[G_RB_RING]
-    pair = np.empty(6)
-    pair_t = np.empty(6)
-    # sun mesh: sun (0..2) and planet (9..11)
-    for k in range(3):
-        pair[k], pair[3 + k] = q[k], q[9 + k]
-        pair_t[k], pair_t[3 + k] = q_t[k], q_t[9 + k]
-    d, nx, ny, phi, _ = pair_deflection(pair, rbs, rbp, False, phi_ref)
-    rate = _rate(nx, ny, pair_t, rbs, rbp, False)
-    F_sun = mesh_contact(q[2] - phi + G[G_ANGLE_SUN], d - G[G_DELTA0_SUN], rate, P_sun)[0]
+    a_s, d_s, v_s, nx, ny, a_r, d_r, v_r, mx, my = planet_mesh_states(q, q_t, G)
+    F_sun = mesh_contact(a_s, d_s, v_s, P_sun)[0]
     f[0] -= F_sun * nx
     f[1] -= F_sun * ny
     f[2] -= F_sun * rbs
     f[9] += F_sun * nx
     f[10] += F_sun * ny
     f[11] -= F_sun * rbp
-    # ring mesh: ring (3..5) and planet
-    for k in range(3):
-        pair[k], pair_t[k] = q[3 + k], q_t[3 + k]
-    d, nx, ny, phi, _ = pair_deflection(pair, rbr, rbp, True, phi_ref)
-    rate = _rate(nx, ny, pair_t, rbr, rbp, True)
-    # the ring's angle relative to the line of centres, negated: it grows as the mesh engages (carrier
-    # turning counter-clockwise in the ring), so the law's tooth counter and phase run forwards
-    F_ring = mesh_contact(phi - q[5] + G[G_ANGLE_RING], d - G[G_DELTA0_RING], rate, P_ring)[0]
-    f[3] -= F_ring * nx
-    f[4] -= F_ring * ny
+    F_ring = mesh_contact(a_r, d_r, v_r, P_ring)[0]
+    f[3] -= F_ring * mx
+    f[4] -= F_ring * my
     f[5] -= F_ring * rbr
-    f[9] += F_ring * nx
-    f[10] += F_ring * ny
+    f[9] += F_ring * mx
+    f[10] += F_ring * my
     f[11] += F_ring * rbp
     # planet bearing on the carrier
     rc = G[G_CARRIER_RADIUS]
@@ -195,3 +210,25 @@ def stage_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarra
         for i in range(3):
             f[o + i] += fk[9 + i]
     return f
+
+
+@njit(cache=True)
+def stage_mesh_series(q: np.ndarray, q_t: np.ndarray, G: np.ndarray) -> np.ndarray:
+    """The mesh states of every planet over samples: ``q``, ``q_t`` (n_t x (9 + 3 N)) absolute
+    coordinates as in :func:`stage_forces`; returns (n_t, N, 6): law angle, deflection and rate of the
+    sun mesh, then of the ring mesh (:func:`planet_mesh_states`)."""
+    nt, n = q.shape[0], G.shape[0]
+    out = np.empty((nt, n, 6))
+    qk = np.empty(12)
+    qtk = np.empty(12)
+    for m in range(nt):
+        for i in range(9):
+            qk[i], qtk[i] = q[m, i], q_t[m, i]
+        for k in range(n):
+            o = 9 + 3 * k
+            for i in range(3):
+                qk[9 + i], qtk[9 + i] = q[m, o + i], q_t[m, o + i]
+            a_s, d_s, v_s, _, _, a_r, d_r, v_r, _, _ = planet_mesh_states(qk, qtk, G[k])
+            out[m, k, 0], out[m, k, 1], out[m, k, 2] = a_s, d_s, v_s
+            out[m, k, 3], out[m, k, 4], out[m, k, 5] = a_r, d_r, v_r
+    return out

@@ -31,6 +31,7 @@ __all__ = [
     "spectrum_figure",
 ]
 
+
 def _threshold_line(ax, kd_threshold: float | None) -> None:
     if kd_threshold is not None:
         ax.axhline(

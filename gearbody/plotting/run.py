@@ -23,9 +23,7 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
     out = Path(out_dir)
     title = result.meta.get("title", result.meta.get("scene", ""))
     paths = [
-        plot_kd_time(
-            result.time_s, result.kd, out / "kd_time.png", title=f"{title}: K_d = F(t)/F_rated"
-        )
+        plot_kd_time(result.time_s, result.kd, out / "kd_time.png", title=f"{title}: K_d = F(t)/F_rated")
     ]
     win = result.final_window()  # the steady end of the run (Result.FINAL_FRACTION)
     f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))

@@ -102,7 +102,11 @@ def report_sections(result: Result) -> dict[str, Any]:
         f_max = min(result.sample_rate_hz / 2, 6 * f_mesh)
         lines = spectrum_lines(f_mesh / z1, teeth, f_max)
         peaks = label_peaks(
-            spec, lines, tolerance_hz=1.5 * spec.resolution_hz, min_prominence_db=12.0, max_peaks=40,
+            spec,
+            lines,
+            tolerance_hz=1.5 * spec.resolution_hz,
+            min_prominence_db=12.0,
+            max_peaks=40,
             f_max_hz=f_max,
         )
         title = f"spectrum of {name} [{unit}], last {result.FINAL_FRACTION:.0%} of the run"

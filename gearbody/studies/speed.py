@@ -56,8 +56,15 @@ class SpeedSweep:
     """Per speed: "" or the error message of a failed run."""
 
     def rows(self) -> list[dict]:
-        keys = ("speed_fraction", "pinion_speed_rad_s", "mesh_frequency_hz", "kd_max", "kd_min",
-                "kd_rms_dynamic", "separation_fraction")
+        keys = (
+            "speed_fraction",
+            "pinion_speed_rad_s",
+            "mesh_frequency_hz",
+            "kd_max",
+            "kd_min",
+            "kd_rms_dynamic",
+            "separation_fraction",
+        )
         return [
             {**{k: float(getattr(self, k)[i]) for k in keys}, "error": self.errors[i]}
             for i in range(self.speed_fraction.size)
@@ -97,8 +104,13 @@ def kd_speed_sweep(
         load_scenario(data, ov)
     jobs = [(f"speed-{i:04d}", (data, ov, settle_s)) for i, ov in enumerate(overrides)]
     outcomes = dict(
-        run_jobs(speed_case, jobs, workers=None if scheduler is not None else max(int(workers), 1),
-                 scheduler=scheduler, name="gearbody-speed")
+        run_jobs(
+            speed_case,
+            jobs,
+            workers=None if scheduler is not None else max(int(workers), 1),
+            scheduler=scheduler,
+            name="gearbody-speed",
+        )
     )
     columns: dict[str, list[float]] = {k: [] for k in SPEED_VALUES}
     errors = []

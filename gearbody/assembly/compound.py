@@ -1,0 +1,287 @@
+"""Layout and initial state of a drive with planetary stages (a "compound" train): motor, shafts,
+parallel stages (torsional), planetary stages (every member a planar body) and machine, in the
+coordinates of docs/planetary.md, "The stage in a drive". Engine-free: the Exudyn builder
+(:mod:`gearbody.engine.compound`) creates exactly what :func:`compound_layout` lists.
+
+Coordinates: ``motor``, per parallel stage ``pinion(_s)`` and ``wheel(_s)``, per planetary stage
+``<p>sun_x, <p>sun_y, <p>sun, <p>ring_x, ..., <p>carrier, <p>planet_1_x, ..., <p>planet_N`` (prefix
+``<p>`` empty for stage 1, ``stage_<s>_`` after; x, y and rotation displacements from the nominal
+assembly, absolute rotations counter-clockwise), then ``machine``. Parallel-stage and chain rotations are
+positive in their driven direction; a planetary input (output) member turns with sense ``s_in``
+(``s_out``), so a shaft to it acts on ``s theta``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import root
+
+from ..errors import InputError
+from ..model import Scenario
+from ..model.planetary import PlanetaryStage
+from ..physics.planetary_mesh import stage_forces
+from .operating_point import static_deflection_m, steady_operating_point
+from .parameters import mesh_parameters_from_scenario, pack_drive_parameters
+from .planetary_layout import CENTRAL, PlanetaryLayout, layout_from_stage
+from .topology import gear_names
+
+__all__ = [
+    "ChainShaft",
+    "CompoundLayout",
+    "PlanetaryLink",
+    "compound_initial_state",
+    "compound_layout",
+    "planetary_member_names",
+    "stage_prefix",
+]
+
+
+def stage_prefix(stage: int) -> str:
+    """Signal and coordinate prefix of a stage: none for the first, ``stage_<s>_`` after."""
+    return "" if stage == 0 else f"stage_{stage + 1}_"
+
+
+def planetary_member_names(stage: int, planets: int) -> tuple[str, ...]:
+    """Member names of a planetary stage: sun, ring, carrier, planet_1..N (with the stage prefix)."""
+    p = stage_prefix(stage)
+    return (*(p + m for m in CENTRAL), *(f"{p}planet_{n + 1}" for n in range(planets)))
+
+
+@dataclass(frozen=True)
+class PlanetaryLink:
+    """A planetary stage in the coordinate list: its layout, the index of its first coordinate (sun x;
+    9 + 3 N consecutive coordinates), roles, turning senses and rated force per planet mesh."""
+
+    stage: int
+    layout: PlanetaryLayout = field(repr=False)
+    first: int
+    names: tuple[str, ...]
+    input: str
+    output: str
+    fixed: str
+    input_sense: int
+    output_sense: int
+    rated_force_N: float
+
+    def rotation_index(self, member: str) -> int:
+        """Coordinate index of a central member's rotation."""
+        return self.first + 3 * CENTRAL.index(member) + 2
+
+    @property
+    def size(self) -> int:
+        return 3 * len(self.names)
+
+    def reference(self) -> np.ndarray:
+        """Absolute coordinates of the nominal assembly (planet centres on the carrier circle)."""
+        ref = np.zeros(self.size)
+        for n in range(len(self.layout.planet_angles_rad)):
+            ref[9 + 3 * n : 11 + 3 * n] = self.layout.planet_centre_m(n)
+        return ref
+
+    def geometry_rows(self) -> np.ndarray:
+        """One geometry row per planet for :func:`gearbody.physics.planetary_mesh.stage_forces`."""
+        return np.array([self.layout.geometry(n) for n in range(len(self.layout.planet_angles_rad))])
+
+
+@dataclass(frozen=True)
+class ChainShaft:
+    """Torsional spring-damper of the chain, moment ``k (s_i q_i - s_j q_j) + C (...)'`` on coordinates
+    i (upstream) and j (downstream); s = -1 where a planetary member turns clockwise."""
+
+    i: int
+    j: int
+    stiffness_Nm_per_rad: float
+    damping_Nms_per_rad: float
+    sign_i: int = 1
+    sign_j: int = 1
+
+
+@dataclass(frozen=True)
+class ParallelMesh:
+    """A parallel (torsional) stage's mesh between pinion and wheel coordinates."""
+
+    stage: int
+    pinion: int
+    wheel: int
+    parameters: np.ndarray = field(repr=False)
+
+
+@dataclass(frozen=True)
+class CompoundLayout:
+    dof_names: tuple[str, ...]
+    inertias: tuple[float, ...]  # per rotation-only body (motor, gears, machine): its inertia
+    rotation_bodies: tuple[int, ...]  # coordinate index of each rotation-only body
+    shafts: tuple[ChainShaft, ...]
+    meshes: tuple[ParallelMesh, ...]
+    planetary: tuple[PlanetaryLink, ...]
+    motor_at: int
+    load_at: int
+    drive: np.ndarray = field(repr=False)
+
+
+def compound_layout(scenario: Scenario) -> CompoundLayout:
+    """The coordinates, bodies, shafts, meshes and planetary stages of a train with planetary stages."""
+    d = scenario.design
+    names: list[str] = ["motor"]
+    inertias, bodies = [d.motor.inertia_kg_m2], [0]
+    meshes, planetary = [], []
+    ends = []  # per stage: (input coordinate, its sense, output coordinate, its sense)
+    for k, st in enumerate(scenario.stages):
+        if isinstance(st, PlanetaryStage):
+            link = PlanetaryLink(
+                k,
+                layout_from_stage(st, k, scenario.meta.seed),
+                len(names),
+                planetary_member_names(k, st.planets),
+                st.input,
+                st.output,
+                st.fixed,
+                st.input_sense,
+                st.output_sense,
+                scenario.stage_rated_force_N(k),
+            )
+            for member in link.names:
+                names += [f"{member}_x", f"{member}_y", member]
+            planetary.append(link)
+            ends.append(
+                (
+                    link.rotation_index(st.input),
+                    st.input_sense,
+                    link.rotation_index(st.output),
+                    st.output_sense,
+                )
+            )
+        else:
+            pname, wname = gear_names(k)
+            ip = len(names)
+            names += [pname, wname]
+            inertias += [st.pinion.inertia_kg_m2, st.wheel.inertia_kg_m2]
+            bodies += [ip, ip + 1]
+            meshes.append(ParallelMesh(k, ip, ip + 1, mesh_parameters_from_scenario(scenario, k)))
+            ends.append((ip, 1, ip + 1, 1))
+    names.append("machine")
+    inertias.append(d.machine.inertia_kg_m2)
+    bodies.append(len(names) - 1)
+    shafts = []
+    upstream = (0, 1)
+    for k, sh in enumerate(d.shafts):
+        down = (len(names) - 1, 1) if k == len(ends) else (ends[k][0], ends[k][1])
+        shafts.append(
+            ChainShaft(
+                upstream[0], down[0], sh.stiffness_Nm_per_rad, sh.damping_Nms_per_rad, upstream[1], down[1]
+            )
+        )
+        if k < len(ends):
+            upstream = (ends[k][2], ends[k][3])
+    return CompoundLayout(
+        tuple(names),
+        tuple(inertias),
+        tuple(bodies),
+        tuple(shafts),
+        tuple(meshes),
+        tuple(planetary),
+        0,
+        len(names) - 1,
+        pack_drive_parameters(scenario),
+    )
+
+
+def _support_forces(link: PlanetaryLink, q_rel: np.ndarray) -> np.ndarray:
+    """Central members' bearings and the fixed member's torsional support (elastic part) on the stage's
+    coordinates (displacements from the nominal assembly)."""
+    f = np.zeros(link.size)
+    for m, member in enumerate(link.layout.members):
+        o = 3 * m
+        f[o : o + 2] -= member.bearing_stiffness_N_per_m * q_rel[o : o + 2]
+        if member.torsion_stiffness_Nm_per_rad is not None:
+            f[o + 2] -= member.torsion_stiffness_Nm_per_rad * q_rel[o + 2]
+    return f
+
+
+def stage_static_displacements(
+    link: PlanetaryLink, input_torque_Nm: float, output_torque_Nm: float, input_angle_rad: float = 0.0
+) -> np.ndarray:
+    """Static equilibrium of a planetary stage (displacements from the nominal assembly) under the signed
+    external torques on its input and output members: exact deflections, the mesh laws at this state
+    without damping, no centripetal terms; the input rotation held at ``input_angle_rad`` (the gauge);
+    Newton from the nominal assembly (docs/planetary.md, "Initial state")."""
+    ref, G = link.reference(), link.geometry_rows()
+    Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
+    gauge = 3 * CENTRAL.index(link.input) + 2
+    free = np.array([i for i in range(link.size) if i != gauge])
+    torques = np.zeros(link.size)
+    torques[3 * CENTRAL.index(link.input) + 2] += input_torque_Nm
+    torques[3 * CENTRAL.index(link.output) + 2] += output_torque_Nm
+    zero = np.zeros(link.size)
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        q = np.zeros(link.size)
+        q[gauge] = input_angle_rad
+        q[free] = x
+        f = stage_forces(ref + q, zero, G, Ps, Pr) + _support_forces(link, q) + torques
+        return f[free]
+
+    scale = max(abs(input_torque_Nm), abs(output_torque_Nm), 1.0)
+    sol = root(residual, np.zeros(free.size), method="hybr", options={"xtol": 1e-14})
+    q = np.zeros(link.size)
+    q[gauge] = input_angle_rad
+    q[free] = sol.x
+    if not sol.success or np.max(np.abs(residual(sol.x))) > 1e-6 * scale:
+        raise InputError(
+            f"operation.initial_state = 'steady': stage {link.stage + 1}: no static equilibrium of the "
+            f"planetary stage found ({sol.message}); start from rest"
+        )
+    return q
+
+
+def compound_initial_state(scenario: Scenario, layout: CompoundLayout) -> tuple[np.ndarray, np.ndarray]:
+    """Initial coordinates and velocities (docs/planetary.md, "Initial state"): all zero from rest;
+    'steady': rigid speeds, each stage at static equilibrium under its share of the initial load, the
+    chain's angles stage by stage in power-flow order as for trains."""
+    n = len(layout.dof_names)
+    q, v = np.zeros(n), np.zeros(n)
+    if scenario.operation.initial_state == "rest":
+        return q, v
+    op = steady_operating_point(scenario)
+    links = {link.stage: link for link in layout.planetary}
+    meshes = {m.stage: m for m in layout.meshes}
+    shafts = scenario.design.shafts
+    angle_in = 0.0  # the stage input's angle in the chain's driven direction (first stage: 0)
+    for k, st in enumerate(scenario.stages):
+        force, w_in = op["mesh_force_N"][k], op["pinion_speed_rad_s"][k]
+        T_in = force * st.input_arm_m
+        if k == 0:
+            q[0], v[0] = angle_in + T_in / shafts[0].stiffness_Nm_per_rad, w_in
+        if k in links:
+            link = links[k]
+            s_in, s_out = link.input_sense, link.output_sense
+            o = link.first
+            q[o : o + link.size] = stage_static_displacements(
+                link, s_in * T_in, -s_out * force * st.output_arm_m, s_in * angle_in
+            )
+            speeds = {}
+            if w_in:
+                willis = st.speeds(w_in)
+                speeds = {m: s_in * willis.of(m) for m in CENTRAL} | {"planet": s_in * willis.planet_rad_s}
+            for m, member in enumerate(CENTRAL):
+                v[o + 3 * m + 2] = speeds.get(member, 0.0)
+            wc = speeds.get("carrier", 0.0)
+            for p in range(st.planets):
+                x, y = link.layout.planet_centre_m(p)
+                v[o + 9 + 3 * p : o + 12 + 3 * p] = (-wc * y, wc * x, speeds.get("planet", 0.0))
+            angle_out = s_out * q[link.rotation_index(st.output)]
+        else:
+            m = meshes[k]
+            delta = static_deflection_m(scenario, k, angle_in, force)
+            q[m.pinion] = angle_in
+            q[m.wheel] = angle_out = (st.pinion.base_radius_m * angle_in - delta) / st.wheel.base_radius_m
+            v[m.pinion], v[m.wheel] = w_in, op["wheel_speed_rad_s"][k]
+        if k + 1 < len(scenario.stages):
+            T_next = op["mesh_force_N"][k + 1] * scenario.stages[k + 1].input_arm_m
+            angle_in = angle_out - T_next / shafts[k + 1].stiffness_Nm_per_rad
+        else:
+            q[-1] = angle_out - op["load_torque_Nm"] / shafts[-1].stiffness_Nm_per_rad
+            v[-1] = op["wheel_speed_rad_s"][k]
+    return q, v

@@ -1,0 +1,166 @@
+"""Exudyn system of a drive with planetary stages (:mod:`gearbody.assembly.compound`): the motor,
+parallel gears and machine are rotational masses (``Node1D``), every planetary member a planar rigid
+body (``NodeRigidBody2D`` + ``ObjectRigidBody2D``, coordinates displacements from the nominal assembly);
+the central members' supports are coordinate spring-dampers to the ground, the fixed member's torsional
+support one more; shafts are coordinate spring-dampers, or a constant-matrix ``ObjectGenericODE2`` where a
+planetary member turns clockwise (``s = -1``); each planetary stage is one ``ObjectGenericODE2`` on its
+nodes calling the compiled :func:`gearbody.physics.planetary_mesh.stage_forces` (every planet's meshes
+and bearing); motor, load and parallel meshes are the train's user-function items.
+"""
+
+from __future__ import annotations
+
+import exudyn as exu
+import numpy as np
+from exudyn.itemInterface import (
+    MarkerNodeCoordinate,
+    Node1D,
+    NodePointGround,
+    NodeRigidBody2D,
+    ObjectConnectorCoordinateSpringDamper,
+    ObjectGenericODE2,
+    ObjectRigidBody2D,
+    ObjectRotationalMass1D,
+)
+
+from ..assembly.compound import CompoundLayout, PlanetaryLink
+from ..physics.planetary_mesh import stage_forces
+from .build import HIDDEN, BuiltSystem, _add_sensors
+from .user_functions import compiled, load_user_function, mesh_user_function, motor_user_function
+
+__all__ = ["build_compound", "planetary_stage_user_function"]
+
+
+def planetary_stage_user_function(link: PlanetaryLink):
+    """The force function of one planetary stage's item: coordinates are displacements from the nominal
+    assembly, the compiled law takes absolute ones."""
+    ref, G = link.reference(), link.geometry_rows()
+    Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
+    forces = compiled(stage_forces, ref, ref, G, Ps, Pr)
+
+    def stage_items(mbs, t, itemNumber, q, q_t):
+        return forces(np.asarray(q) + ref, np.asarray(q_t), G, Ps, Pr)
+
+    return stage_items
+
+
+def build_compound(
+    layout: CompoundLayout, q0: np.ndarray, v0: np.ndarray, *, sensors: bool = True
+) -> BuiltSystem:
+    """Exudyn system of a compound layout at initial coordinates ``q0`` and velocities ``v0`` (one per
+    coordinate of ``layout.dof_names``)."""
+    SC = exu.SystemContainer()
+    mbs = SC.AddSystem()
+    names = list(layout.dof_names)
+    node_of: dict[int, tuple[int, int]] = {}  # coordinate index -> (node, coordinate in node)
+    nodes: list[int] = []
+    planar_first = {link.first + 3 * m for link in layout.planetary for m in range(len(link.names))}
+    masses = {}
+    for link in layout.planetary:
+        members = (*link.layout.members, *([link.layout.planet] * (len(link.names) - 3)))
+        for m, member in enumerate(members):
+            masses[link.first + 3 * m] = member
+    rotation = dict(zip(layout.rotation_bodies, layout.inertias, strict=True))
+    i = 0
+    while i < len(names):
+        if i in planar_first:
+            nd = mbs.AddNode(
+                NodeRigidBody2D(
+                    referenceCoordinates=[0.0, 0.0, 0.0],
+                    initialCoordinates=[float(x) for x in q0[i : i + 3]],
+                    initialVelocities=[float(x) for x in v0[i : i + 3]],
+                )
+            )
+            member = masses[i]
+            mbs.AddObject(ObjectRigidBody2D(nodeNumber=nd, mass=member.mass_kg, inertia=member.inertia_kg_m2))
+            for d in range(3):
+                node_of[i + d] = (nd, d)
+            i += 3
+        else:
+            nd = mbs.AddNode(
+                Node1D(
+                    referenceCoordinates=[0.0],
+                    initialCoordinates=[float(q0[i])],
+                    initialVelocities=[float(v0[i])],
+                )
+            )
+            mbs.AddObject(ObjectRotationalMass1D(nodeNumber=nd, inertia=rotation[i]))
+            node_of[i] = (nd, 0)
+            i += 1
+        nodes.append(nd)
+    built = BuiltSystem(SC, mbs, names, nodes)
+    marker = {}
+
+    def coordinate_marker(index: int) -> int:
+        if index not in marker:
+            nd, d = node_of[index]
+            marker[index] = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=nd, coordinate=d))
+        return marker[index]
+
+    ground = mbs.AddNode(NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
+    ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+
+    def spring(a: int, b: int | None, k: float, c: float) -> None:
+        """k, c between coordinate a and b (None: the ground)."""
+        pair = [ground_marker if b is None else coordinate_marker(b), coordinate_marker(a)]
+        mbs.AddObject(ObjectConnectorCoordinateSpringDamper(markerNumbers=pair, stiffness=k, damping=c))
+
+    for link in layout.planetary:
+        for m, member in enumerate(link.layout.members):
+            o = link.first + 3 * m
+            for d in (0, 1):
+                spring(o + d, None, member.bearing_stiffness_N_per_m, member.bearing_damping_Ns_per_m)
+            if member.torsion_stiffness_Nm_per_rad is not None:
+                spring(o + 2, None, member.torsion_stiffness_Nm_per_rad, member.torsion_damping_Nms_per_rad)
+    for sh in layout.shafts:
+        if sh.sign_i == sh.sign_j == 1:
+            spring(sh.j, sh.i, sh.stiffness_Nm_per_rad, sh.damping_Nms_per_rad)
+            continue
+        _signed_shaft(built, node_of, sh)
+    D = layout.drive
+    items = [
+        ([layout.motor_at], motor_user_function(D, built.watchdog)),
+        ([layout.load_at], load_user_function(D)),
+        *(([m.pinion, m.wheel], mesh_user_function(m.parameters)) for m in layout.meshes),
+    ]
+    for link in layout.planetary:
+        items.append((list(range(link.first, link.first + link.size)), planetary_stage_user_function(link)))
+    for coordinates, function in items:
+        item_nodes = list(dict.fromkeys(node_of[c][0] for c in coordinates))
+        size = len(coordinates)
+        built.user_functions.append(function)
+        mbs.AddObject(
+            ObjectGenericODE2(
+                nodeNumbers=item_nodes,
+                massMatrix=np.zeros((size, size)),
+                forceUserFunction=function,
+                visualization=HIDDEN,
+            )
+        )
+    if sensors:
+        _add_sensors(built)
+    mbs.Assemble()
+    return built
+
+
+def _signed_shaft(built: BuiltSystem, node_of, sh) -> None:
+    """A shaft ``k (s_i q_i - s_j q_j)`` as constant stiffness and damping matrices on the two nodes."""
+    pair = []
+    for index in (sh.i, sh.j):
+        nd, _ = node_of[index]
+        if nd not in pair:
+            pair.append(nd)
+    sizes = [len(built.mbs.GetNode(nd)["referenceCoordinates"]) for nd in pair]
+    size = sum(sizes)
+    g = np.zeros(size)
+    g[node_of[sh.i][1]] = sh.sign_i
+    g[sizes[0] + node_of[sh.j][1]] = -sh.sign_j
+    built.mbs.AddObject(
+        ObjectGenericODE2(
+            nodeNumbers=pair,
+            massMatrix=np.zeros((size, size)),
+            stiffnessMatrix=sh.stiffness_Nm_per_rad * np.outer(g, g),
+            dampingMatrix=sh.damping_Nms_per_rad * np.outer(g, g),
+            visualization=HIDDEN,
+        )
+    )

@@ -1,0 +1,107 @@
+"""Signals of a drive's planetary stages, from the recorded (resampled) states: every planet's sun- and
+ring-mesh force, K_d, deflection, mesh phase and teeth in mesh; the central members' centre motion and
+bearing forces on the housing; each planet's bearing deflection in the carrier frame (docs/planetary.md,
+"Signals"). Forces come from the compiled law the solver integrated, on the same states."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..assembly.compound import PlanetaryLink, compound_layout
+from ..assembly.planetary_layout import CENTRAL
+from ..model import Scenario
+from ..model.planetary import PlanetaryStage
+from ..physics.mesh import mesh_contact_series, mesh_phase_series
+from ..physics.planetary_mesh import stage_mesh_series
+from .sampling import mesh_jump_times
+
+__all__ = ["planetary_jump_times", "planetary_signals", "stage_input_name"]
+
+
+def stage_input_name(scenario: Scenario, k: int) -> str:
+    """The coordinate name of stage k's input rotation (pinion, or the planetary input member)."""
+    st = scenario.stages[k]
+    prefix = "" if k == 0 else f"stage_{k + 1}_"
+    if isinstance(st, PlanetaryStage):
+        return prefix + st.input
+    return "pinion" if k == 0 else f"pinion_{k + 1}"
+
+
+def _links(scenario: Scenario) -> tuple[PlanetaryLink, ...]:
+    return compound_layout(scenario).planetary
+
+
+def _stage_states(link: PlanetaryLink, names: list[str], q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """(n_t, N, 6) mesh states of a stage on recorded displacements q, v (n_coordinates x n_t)."""
+    first = names.index(link.names[0] + "_x")
+    rows = slice(first, first + link.size)
+    absolute = np.ascontiguousarray((q[rows] + link.reference()[:, None]).T)
+    rate = np.ascontiguousarray(v[rows].T)
+    return stage_mesh_series(absolute, rate, link.geometry_rows())
+
+
+def planetary_signals(scenario: Scenario, names: list[str], q, v, a) -> dict[str, np.ndarray]:
+    """Every planetary stage's signals on the samples of q, v, a (rows in the order of ``names``)."""
+    out: dict[str, np.ndarray] = {}
+    for link in _links(scenario):
+        k, st = link.stage, scenario.stages[link.stage]
+        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        states = _stage_states(link, names, q, v)
+        for n in range(st.planets):
+            planet = f"{prefix}planet_{n + 1}"
+            for mesh, P, col in (("sun", link.layout.sun_mesh, 0), ("ring", link.layout.ring_mesh, 3)):
+                angle = np.ascontiguousarray(states[:, n, col])
+                delta = np.ascontiguousarray(states[:, n, col + 1])
+                F, _ = mesh_contact_series(angle, delta, np.ascontiguousarray(states[:, n, col + 2]), P)
+                p, i, j = mesh_phase_series(angle, P)
+                key = f"{planet}_{mesh}_mesh"
+                out[key + "_force_N"] = F
+                out[key + "_kd"] = F / link.rated_force_N
+                out[key + "_deflection_m"] = delta
+                out[key + "_phase"] = p
+                out[f"{key}_{mesh}_tooth"] = i
+                out[f"{key}_planet_tooth"] = j
+            out.update(_planet_bearing(link, names, q, n, planet))
+        for m, member in enumerate(link.layout.members):
+            name = link.names[m]
+            ix = names.index(name + "_x")
+            for d, axis in enumerate("xy"):
+                u, du = q[ix + d], v[ix + d]
+                out[f"{name}_{axis}_m"] = u
+                out[f"{name}_{axis}_velocity_m_s"] = du
+                out[f"{name}_{axis}_accel_m_s2"] = a[ix + d]
+                force = member.bearing_stiffness_N_per_m * u + member.bearing_damping_Ns_per_m * du
+                out[f"{name}_bearing_force_{axis}_N"] = force  # on the housing
+        w = {c: v[names.index(link.names[m])] for m, c in enumerate(CENTRAL)}
+        out[prefix + "mesh_frequency_hz"] = st.sun.teeth * np.abs(w["sun"] - w["carrier"]) / (2 * math.pi)
+    return out
+
+
+def _planet_bearing(link: PlanetaryLink, names, q, n: int, planet: str) -> dict[str, np.ndarray]:
+    """Planet n's bearing deflection (centre minus its carrier point), radial and tangential in the
+    carrier frame, m."""
+    rc, psi = link.layout.carrier_radius_m, link.layout.planet_angles_rad[n]
+    ic = names.index(link.names[2] + "_x")
+    ip = names.index(planet + "_x")
+    theta = q[ic + 2] + psi
+    px, py = link.layout.planet_centre_m(n)
+    ex = px + q[ip] - (q[ic] + rc * np.cos(theta))
+    ey = py + q[ip + 1] - (q[ic + 1] + rc * np.sin(theta))
+    c, s = np.cos(theta), np.sin(theta)
+    return {
+        f"{planet}_bearing_radial_m": c * ex + s * ey,
+        f"{planet}_bearing_tangential_m": -s * ex + c * ey,
+    }
+
+
+def planetary_jump_times(scenario: Scenario, k: int, names, t_s: np.ndarray, q, v) -> list[np.ndarray]:
+    """Times where stage k's mesh laws jump (every planet's two meshes), for band-limited sampling."""
+    link = next(link for link in _links(scenario) if link.stage == k)
+    states = _stage_states(link, names, q, v)
+    out = []
+    for n in range(len(link.layout.planet_angles_rad)):
+        for P, col in ((link.layout.sun_mesh, 0), (link.layout.ring_mesh, 3)):
+            out.append(mesh_jump_times(t_s, states[:, n, col], states[:, n, col + 1], P))
+    return out

@@ -1,0 +1,222 @@
+"""A planetary stage of the drive: sun, N planets, internal ring and carrier (issue 19). One more item
+type of ``design.stages`` (``type = "planetary"``); the keys, coordinates and equations are the contract
+of docs/planetary.md, "The stage in a drive"."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+from ..physics.planetary import PlanetaryGeometry, PlanetaryGeometryError, PlanetarySpeeds, planetary_speeds
+from .faults import ErrorMode
+from .params import Node, ScenarioError, param
+
+MEMBERS = ("sun", "ring", "carrier")
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlanetaryMember(Node):
+    """A member of a planetary stage: teeth (not the carrier), mass, inertia, its bearing (the planet's:
+    on the carrier; the others': to the housing) and, for the fixed member, its torsional support."""
+
+    teeth: int | None = param(None, ge=6, doc="number of teeth z (sun, planet, ring; not the carrier)")
+    inertia_kg_m2: float = param(gt=0, doc="polar moment of inertia")
+    mass_kg: float = param(gt=0, doc="mass")
+    bearing_stiffness_N_per_m: float = param(gt=0, doc="isotropic bearing stiffness")
+    bearing_damping_Ns_per_m: float = param(0.0, ge=0, doc="isotropic bearing damping")
+    torsion_stiffness_Nm_per_rad: float | None = param(
+        None, gt=0, doc="torsional support to the housing (the fixed member only, required there)"
+    )
+    torsion_damping_Nms_per_rad: float = param(0.0, ge=0, doc="damping of the torsional support")
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlanetaryMesh(Node):
+    """The law of every sun-planet (or ring-planet) mesh: the parallel mesh law's rectangular stiffness
+    profile, damping, backlash and transition width."""
+
+    stiffness_single_N_per_m: float = param(gt=0, doc="k_z with one tooth pair in contact")
+    stiffness_double_N_per_m: float = param(gt=0, doc="k_z with two tooth pairs in contact")
+    contact_ratio: float | None = param(
+        None, ge=1, lt=2, doc="transverse contact ratio (unset: of the standard teeth)"
+    )
+    damping_Ns_per_m: float = param(0.0, ge=0, doc="mesh damping C_z")
+    backlash_um: float = param(0.0, ge=0, le=1000, doc="half the flank clearance l_u")
+    pitch_point_phase: float = param(0.5, gt=0, lt=1, doc="mesh phase of the pitch point")
+    transition_width: float = param(
+        0.0, ge=0, le=0.2, doc="fraction of the mesh period over which the tooth change is smoothed"
+    )
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlanetaryStage(Node):
+    """A simple planetary stage: standard spur teeth (z_r = z_s + 2 z_p), N planets, any of sun, ring
+    and carrier as input, output or fixed (the third)."""
+
+    KIND: ClassVar[str] = "planetary"
+
+    type: str = param("planetary", choices=("planetary",), doc="stage type")
+    planets: int = param(ge=1, le=12, doc="number of planets N")
+    planet_angles_deg: tuple[float, ...] = param(
+        (), doc="planet position angles, the first 0 (empty: equally spaced 360 (n - 1) / N)"
+    )
+    module_mm: float = param(gt=0, le=100, doc="module m")
+    pressure_angle_deg: float = param(20.0, ge=10, le=35, doc="pressure angle alpha")
+    input: str = param(choices=MEMBERS, doc="member driven by the previous shaft")
+    output: str = param(choices=MEMBERS, doc="member driving the next shaft")
+    sun: PlanetaryMember
+    planet: PlanetaryMember
+    ring: PlanetaryMember
+    carrier: PlanetaryMember
+    sun_mesh: PlanetaryMesh
+    ring_mesh: PlanetaryMesh
+    sun_error_mode: ErrorMode = param(default_factory=ErrorMode, doc="E(a, e, r) on the sun's teeth")
+    ring_error_mode: ErrorMode = param(default_factory=ErrorMode, doc="E(a, e, r) on the ring's teeth")
+
+    def __post_init__(self) -> None:
+        if self.input == self.output:
+            raise ScenarioError(f"output = {self.output!r}: must differ from input = {self.input!r}")
+        for name in ("sun", "planet", "ring"):
+            if getattr(self, name).teeth is None:
+                raise ScenarioError(f"{name}.teeth: required (number of teeth, >= 6)")
+        if self.carrier.teeth is not None:
+            raise ScenarioError(f"carrier.teeth = {self.carrier.teeth}: the carrier has no teeth; remove it")
+        for name in MEMBERS:
+            member = getattr(self, name)
+            if name == self.fixed and member.torsion_stiffness_Nm_per_rad is None:
+                raise ScenarioError(
+                    f"{name}.torsion_stiffness_Nm_per_rad: required on the fixed member ({name}: neither "
+                    "input nor output), its torsional support to the housing (> 0)"
+                )
+            if name != self.fixed and member.torsion_stiffness_Nm_per_rad is not None:
+                raise ScenarioError(
+                    f"{name}.torsion_stiffness_Nm_per_rad = {member.torsion_stiffness_Nm_per_rad:g}: only "
+                    f"the fixed member ({self.fixed}) has a torsional support; the {name} is the stage's "
+                    f"{'input' if name == self.input else 'output'}"
+                )
+        if self.planet.torsion_stiffness_Nm_per_rad is not None:
+            raise ScenarioError("planet.torsion_stiffness_Nm_per_rad: planets turn freely on the carrier")
+        if self.planet_angles_deg:
+            self._check_angles()
+        try:
+            self.geometry  # noqa: B018  (assembly condition, spacing, overlap: refused before anything runs)
+        except PlanetaryGeometryError as exc:
+            raise ScenarioError(_stage_geometry_message(str(exc))) from None
+
+    def _check_angles(self) -> None:
+        """Given planet angles, in degrees: one per planet, the first 0, increasing below 360, each on the
+        mesh condition (z_s + z_r) psi / 360 an integer."""
+        angles = self.planet_angles_deg
+        if len(angles) != self.planets:
+            raise ScenarioError(
+                f"planet_angles_deg has {len(angles)} angles: planets = {self.planets} needs one per "
+                "planet (or none: equally spaced)"
+            )
+        if angles[0] != 0.0:
+            raise ScenarioError(f"planet_angles_deg.1 = {angles[0]:g}: planet 1 is the reference, at 0")
+        for k in range(1, len(angles)):
+            if not angles[k - 1] < angles[k] < 360.0:
+                raise ScenarioError(
+                    f"planet_angles_deg.{k + 1} = {angles[k]:g}: angles increase (planets numbered "
+                    f"counter-clockwise); allowed: > {angles[k - 1]:g} and < 360"
+                )
+        total = self.sun.teeth + self.ring.teeth
+        step = 360.0 / total
+        for k, a in enumerate(angles):
+            if abs(a / step - round(a / step)) > 1e-6:
+                nearest = ", ".join(f"{round(b / step) * step:.6g}" for b in angles)
+                raise ScenarioError(
+                    f"planet_angles_deg.{k + 1} = {a:g}: off the mesh condition (z_s + z_r) psi / 360 "
+                    f"integer (z_s + z_r = {total}); allowed: multiples of 360 / {total} = {step:.6g} deg, "
+                    f"nearest valid angles [{nearest}]"
+                )
+
+    @property
+    def fixed(self) -> str:
+        """The member that is neither input nor output (held by its torsional support)."""
+        return next(m for m in MEMBERS if m not in (self.input, self.output))
+
+    @property
+    def geometry(self) -> PlanetaryGeometry:
+        """The checked geometry (teeth, module, pressure angle, planet angles)."""
+        total = self.sun.teeth + self.ring.teeth
+        return PlanetaryGeometry(
+            z_sun=self.sun.teeth,
+            z_planet=self.planet.teeth,
+            z_ring=self.ring.teeth,
+            n_planets=self.planets,
+            module_m=self.module_mm * 1e-3,
+            pressure_angle_deg=self.pressure_angle_deg,
+            # on the mesh condition to 1e-6 of a tooth (checked): snapped to it exactly
+            planet_angles_rad=tuple(
+                2.0 * math.pi * round(a * total / 360.0) / total for a in self.planet_angles_deg
+            ),
+        )
+
+    def torque_arm_m(self, member: str) -> float:
+        """r_eq: a member's external torque per unit planet mesh force, N r_bs (sun), N r_br (ring),
+        N (r_bs + r_br) (carrier)."""
+        g = self.geometry
+        arms = {"sun": g.sun_base_radius_m, "ring": g.ring_base_radius_m}
+        arms["carrier"] = arms["sun"] + arms["ring"]
+        return self.planets * arms[member]
+
+    @property
+    def input_arm_m(self) -> float:
+        """r_eq of the input member (plays the pinion's base radius in the chain)."""
+        return self.torque_arm_m(self.input)
+
+    @property
+    def output_arm_m(self) -> float:
+        """r_eq of the output member (plays the wheel's base radius in the chain)."""
+        return self.torque_arm_m(self.output)
+
+    @property
+    def ratio(self) -> float:
+        """Speed ratio input / output (magnitude)."""
+        return self.output_arm_m / self.input_arm_m
+
+    @property
+    def input_sense(self) -> int:
+        """s_in: +1 when the input member turns counter-clockwise at positive power flow (sun or ring
+        input), -1 for a carrier input: the sense that loads the modelled flanks (docs/planetary.md)."""
+        return -1 if self.input == "carrier" else 1
+
+    @property
+    def output_sense(self) -> int:
+        """s_out = s_in sign(w_out / w_in): the output turns with the input unless the carrier is fixed."""
+        return self.input_sense * (-1 if self.fixed == "carrier" else 1)
+
+    def speeds(self, input_speed_rad_s: float) -> PlanetarySpeeds:
+        """Rigid-rolling speeds of every member (Willis) with the input at ``input_speed_rad_s``."""
+        return planetary_speeds(self.geometry, self.input, self.output, self.fixed, input_speed_rad_s)
+
+    def mesh_frequency_hz(self, input_speed_rad_s: float) -> float:
+        """Mesh frequency z_s |w_s - w_c| / 2 pi at an input speed."""
+        if input_speed_rad_s == 0.0:
+            return 0.0
+        return self.speeds(input_speed_rad_s).mesh_frequency_hz
+
+    @property
+    def transition_width(self) -> float:
+        """The wider of the two meshes' transition widths."""
+        return max(self.sun_mesh.transition_width, self.ring_mesh.transition_width)
+
+    @property
+    def coordinate_count(self) -> int:
+        """x, y and rotation of sun, ring, carrier and every planet."""
+        return 3 * (3 + self.planets)
+
+
+def _stage_geometry_message(text: str) -> str:
+    """A PlanetaryGeometry message in the stage's own key names."""
+    for old, new in (
+        ("z_sun", "sun.teeth"),
+        ("z_planet", "planet.teeth"),
+        ("z_ring", "ring.teeth"),
+        ("n_planets", "planets"),
+        ("module_m ", "module_mm "),
+    ):
+        text = text.replace(old, new)
+    return text
