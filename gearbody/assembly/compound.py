@@ -16,7 +16,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import root
 
 from ..errors import InputError
 from ..model import Scenario
@@ -33,9 +32,16 @@ __all__ = [
     "PlanetaryLink",
     "compound_initial_state",
     "compound_layout",
+    "stage_stiffness_matrix",
     "planetary_member_names",
     "stage_prefix",
 ]
+
+
+MAX_NEWTON_ITERATIONS = 30
+STATIC_TOLERANCE = 1e-9
+"""Largest residual force of the static start, relative to the stage's largest external torque (N or
+N m per N m)."""
 
 
 def stage_prefix(stage: int) -> str:
@@ -121,8 +127,9 @@ class CompoundLayout:
     drive: np.ndarray = field(repr=False)
 
 
-def compound_layout(scenario: Scenario) -> CompoundLayout:
-    """The coordinates, bodies, shafts, meshes and planetary stages of a train with planetary stages."""
+def compound_layout(scenario: Scenario, *, modal: bool = False) -> CompoundLayout:
+    """The coordinates, bodies, shafts, meshes and planetary stages of a train with planetary stages
+    (``modal``: planetary meshes as constant springs at their mean stiffness, for the modes)."""
     d = scenario.design
     names: list[str] = ["motor"]
     inertias, bodies = [d.motor.inertia_kg_m2], [0]
@@ -132,7 +139,7 @@ def compound_layout(scenario: Scenario) -> CompoundLayout:
         if isinstance(st, PlanetaryStage):
             link = PlanetaryLink(
                 k,
-                layout_from_stage(st, k, scenario.meta.seed),
+                layout_from_stage(st, k, scenario.meta.seed, modal=modal),
                 len(names),
                 planetary_member_names(k, st.planets),
                 st.input,
@@ -188,6 +195,23 @@ def compound_layout(scenario: Scenario) -> CompoundLayout:
     )
 
 
+def stage_stiffness_matrix(link: PlanetaryLink, step: float = 1e-7) -> np.ndarray:
+    """-d(forces)/dq of a planetary stage's meshes and planet bearings at the nominal assembly, by central
+    differences (``step`` m on centres, m / r_c on rotations): with ``compound_layout(..., modal=True)``
+    the meshes are springs at their mean stiffness through zero deflection, so this is the exact
+    geometry's linearisation (Lin & Parker's matrices in the fixed frame) to O(step^2)."""
+    ref, G = link.reference(), link.geometry_rows()
+    Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
+    zero = np.zeros(link.size)
+    K = np.empty((link.size, link.size))
+    for j in range(link.size):
+        h = step if j % 3 < 2 else step / link.layout.carrier_radius_m
+        e = np.zeros(link.size)
+        e[j] = h
+        K[:, j] = -(stage_forces(ref + e, zero, G, Ps, Pr) - stage_forces(ref - e, zero, G, Ps, Pr)) / (2 * h)
+    return K
+
+
 def _support_forces(link: PlanetaryLink, q_rel: np.ndarray) -> np.ndarray:
     """Central members' bearings and the fixed member's torsional support (elastic part) on the stage's
     coordinates (displacements from the nominal assembly)."""
@@ -224,15 +248,30 @@ def stage_static_displacements(
         return f[free]
 
     scale = max(abs(input_torque_Nm), abs(output_torque_Nm), 1.0)
-    sol = root(residual, np.zeros(free.size), method="hybr", options={"xtol": 1e-14})
-    q = np.zeros(link.size)
-    q[gauge] = input_angle_rad
-    q[free] = sol.x
-    if not sol.success or np.max(np.abs(residual(sol.x))) > 1e-6 * scale:
+    # Newton with a central-difference Jacobian (the laws are piecewise linear in the deflections, the
+    # geometry smooth): steps of 1e-9 m on centres and 1e-9 m / r_c on rotations
+    steps = np.array([1e-9 if i % 3 < 2 else 1e-9 / link.layout.carrier_radius_m for i in free])
+    x = np.zeros(free.size)
+    r = residual(x)
+    for _ in range(MAX_NEWTON_ITERATIONS):
+        if np.max(np.abs(r)) <= STATIC_TOLERANCE * scale:
+            break
+        J = np.empty((free.size, free.size))
+        for j, h in enumerate(steps):
+            e = np.zeros(free.size)
+            e[j] = h
+            J[:, j] = (residual(x + e) - residual(x - e)) / (2 * h)
+        x = x - np.linalg.solve(J, r)
+        r = residual(x)
+    if not np.max(np.abs(r)) <= STATIC_TOLERANCE * scale:
         raise InputError(
             f"operation.initial_state = 'steady': stage {link.stage + 1}: no static equilibrium of the "
-            f"planetary stage found ({sol.message}); start from rest"
+            f"planetary stage found in {MAX_NEWTON_ITERATIONS} Newton steps (largest residual "
+            f"{np.max(np.abs(r)):.3g} N or N m); start from rest"
         )
+    q = np.zeros(link.size)
+    q[gauge] = input_angle_rad
+    q[free] = x
     return q
 
 
@@ -268,8 +307,11 @@ def compound_initial_state(scenario: Scenario, layout: CompoundLayout) -> tuple[
             for m, member in enumerate(CENTRAL):
                 v[o + 3 * m + 2] = speeds.get(member, 0.0)
             wc = speeds.get("carrier", 0.0)
-            for p in range(st.planets):
-                x, y = link.layout.planet_centre_m(p)
+            for p in range(st.planets):  # planet centres turn with the carrier about its (static) centre
+                x, y = (
+                    np.add(link.layout.planet_centre_m(p), q[o + 9 + 3 * p : o + 11 + 3 * p])
+                    - q[o + 6 : o + 8]
+                )
                 v[o + 9 + 3 * p : o + 12 + 3 * p] = (-wc * y, wc * x, speeds.get("planet", 0.0))
             angle_out = s_out * q[link.rotation_index(st.output)]
         else:

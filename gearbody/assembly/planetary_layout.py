@@ -226,11 +226,26 @@ def _member(name: str, m) -> PlanetaryMember:
     )
 
 
-def layout_from_stage(stage, stage_index: int, seed: int) -> PlanetaryLayout:
+def layout_from_stage(stage, stage_index: int, seed: int, *, modal: bool = False) -> PlanetaryLayout:
     """The :class:`PlanetaryLayout` of a scenario's planetary stage (:class:`gearbody.model.planetary.
     PlanetaryStage`, 0-based ``stage_index`` in power-flow order): members, meshes, error modes with the
-    random tooth errors of ``seed`` (docs/planetary.md, "The stage in a drive")."""
+    random tooth errors of ``seed`` (docs/planetary.md, "The stage in a drive"). ``modal``: every mesh a
+    constant spring at its mean stiffness (no backlash, errors or damping), for the linearised modes."""
     from ..physics.error_mode import planetary_tooth_error_depths_m
+    from ..physics.mesh import mean_stiffness_N_per_m
+
+    if modal:
+        full = layout_from_stage(stage, stage_index, seed)
+        k_mean = (mean_stiffness_N_per_m(full.sun_mesh), mean_stiffness_N_per_m(full.ring_mesh))
+        return layout_from_geometry(
+            stage.geometry,
+            sun=_member("sun", stage.sun),
+            ring=_member("ring", stage.ring),
+            carrier=_member("carrier", stage.carrier),
+            planet=_member("planet", stage.planet),
+            stiffness_single_N_per_m=k_mean,
+            stiffness_double_N_per_m=k_mean,
+        )
 
     meshes = (stage.sun_mesh, stage.ring_mesh)
     modes = {"sun": stage.sun_error_mode, "ring": stage.ring_error_mode}

@@ -152,7 +152,7 @@ def _compound_frequencies(scenario: Scenario) -> list[CoordinateFrequency]:
     import numpy as np
 
     from ..physics.planetary_mesh import stage_forces
-    from .compound import compound_layout
+    from .compound import compound_layout, stage_stiffness_matrix
 
     layout = compound_layout(scenario)
     n = len(layout.dof_names)
@@ -181,34 +181,29 @@ def _compound_frequencies(scenario: Scenario) -> list[CoordinateFrequency]:
             )
             keys[i] += ".inertia_kg_m2"
             sources[i] = sources[i] or stage_key(m.stage, "mesh") + ".damping_Ns_per_m"
-    for link in layout.planetary:
+    for link, modal in zip(layout.planetary, compound_layout(scenario, modal=True).planetary, strict=True):
+        K_stage = np.diag(stage_stiffness_matrix(modal))
         ref, G = link.reference(), link.geometry_rows()
         Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
-        zero = np.zeros(link.size)
         members = (*link.layout.members, *([link.layout.planet] * (len(link.names) - 3)))
         for j in range(link.size):
-            h = 1e-9 if j % 3 < 2 else 1e-9 / link.layout.carrier_radius_m
+            i, h = link.first + j, 1e-6
             e = np.zeros(link.size)
             e[j] = h
-            K[link.first + j] -= (
-                stage_forces(ref + e, zero, G, Ps, Pr)[j] - stage_forces(ref - e, zero, G, Ps, Pr)[j]
-            ) / (2 * h)
-            C[link.first + j] -= (
-                stage_forces(ref, e, G, Ps, Pr)[j] - stage_forces(ref, -e, G, Ps, Pr)[j]
-            ) / (2 * h)
+            K[i] += K_stage[j]
+            C[i] -= (stage_forces(ref, e, G, Ps, Pr)[j] - stage_forces(ref, -e, G, Ps, Pr)[j]) / (2 * h)
             member = members[j // 3]
             name = member.name if j < 9 else "planet"
-            keys[link.first + j] = stage_key(link.stage, name) + (
-                ".mass_kg" if j % 3 < 2 else ".inertia_kg_m2"
-            )
-            mass[link.first + j] = member.mass_kg if j % 3 < 2 else member.inertia_kg_m2
+            translation = j % 3 < 2
+            keys[i] = stage_key(link.stage, name) + (".mass_kg" if translation else ".inertia_kg_m2")
+            mass[i] = member.mass_kg if translation else member.inertia_kg_m2
             if j < 9:
-                K[link.first + j] += (
+                K[i] += (
                     member.bearing_stiffness_N_per_m
-                    if j % 3 < 2
-                    else (member.torsion_stiffness_Nm_per_rad or 0.0)
+                    if translation
+                    else member.torsion_stiffness_Nm_per_rad or 0.0
                 )
-            sources[link.first + j] = sources[link.first + j] or stage_key(link.stage, "sun_mesh / ring_mesh")
+            sources[i] = sources[i] or stage_key(link.stage, "sun_mesh / ring_mesh") + ".damping_Ns_per_m"
     return [
         CoordinateFrequency(
             layout.dof_names[i],

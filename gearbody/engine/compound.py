@@ -23,7 +23,8 @@ from exudyn.itemInterface import (
     ObjectRotationalMass1D,
 )
 
-from ..assembly.compound import CompoundLayout, PlanetaryLink
+from ..assembly.compound import CompoundLayout, PlanetaryLink, stage_stiffness_matrix
+from ..physics.mesh import I_R1, I_R2, mean_stiffness_N_per_m
 from ..physics.planetary_mesh import stage_forces
 from .build import HIDDEN, BuiltSystem, _add_sensors
 from .user_functions import compiled, load_user_function, mesh_user_function, motor_user_function
@@ -45,10 +46,12 @@ def planetary_stage_user_function(link: PlanetaryLink):
 
 
 def build_compound(
-    layout: CompoundLayout, q0: np.ndarray, v0: np.ndarray, *, sensors: bool = True
+    layout: CompoundLayout, q0: np.ndarray, v0: np.ndarray, *, sensors: bool = True, modal: bool = False
 ) -> BuiltSystem:
     """Exudyn system of a compound layout at initial coordinates ``q0`` and velocities ``v0`` (one per
-    coordinate of ``layout.dof_names``)."""
+    coordinate of ``layout.dof_names``). ``modal``: the linearised system for natural frequencies, motor
+    and load left out, parallel meshes constant springs at their mean stiffness (the layout's planetary
+    meshes already are, ``compound_layout(..., modal=True)``), linearised by Exudyn at ``q0``."""
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
     names = list(layout.dof_names)
@@ -118,13 +121,38 @@ def build_compound(
             continue
         _signed_shaft(built, node_of, sh)
     D = layout.drive
-    items = [
-        ([layout.motor_at], motor_user_function(D, built.watchdog)),
-        ([layout.load_at], load_user_function(D)),
-        *(([m.pinion, m.wheel], mesh_user_function(m.parameters)) for m in layout.meshes),
-    ]
+    if modal:
+        items = []
+        for m in layout.meshes:
+            r1, r2 = m.parameters[I_R1], m.parameters[I_R2]
+            g = np.array([r1, -r2])
+            mbs.AddObject(
+                ObjectGenericODE2(
+                    nodeNumbers=[node_of[m.pinion][0], node_of[m.wheel][0]],
+                    massMatrix=np.zeros((2, 2)),
+                    stiffnessMatrix=mean_stiffness_N_per_m(m.parameters) * np.outer(g, g),
+                    visualization=HIDDEN,
+                )
+            )
+    else:
+        items = [
+            ([layout.motor_at], motor_user_function(D, built.watchdog)),
+            ([layout.load_at], load_user_function(D)),
+            *(([m.pinion, m.wheel], mesh_user_function(m.parameters)) for m in layout.meshes),
+        ]
     for link in layout.planetary:
-        items.append((list(range(link.first, link.first + link.size)), planetary_stage_user_function(link)))
+        coordinates = list(range(link.first, link.first + link.size))
+        if modal:
+            mbs.AddObject(
+                ObjectGenericODE2(
+                    nodeNumbers=list(dict.fromkeys(node_of[c][0] for c in coordinates)),
+                    massMatrix=np.zeros((link.size, link.size)),
+                    stiffnessMatrix=stage_stiffness_matrix(link),
+                    visualization=HIDDEN,
+                )
+            )
+        else:
+            items.append((coordinates, planetary_stage_user_function(link)))
     for coordinates, function in items:
         item_nodes = list(dict.fromkeys(node_of[c][0] for c in coordinates))
         size = len(coordinates)

@@ -25,9 +25,11 @@ from ..assembly import (
     static_lateral_displacements_m,
     torsional_layout,
 )
+from ..assembly.compound import compound_layout
 from ..model import Scenario
 from ..physics import mean_stiffness_N_per_m
 from .build import build_torsional
+from .compound import build_compound
 
 __all__ = ["ModeSet", "natural_frequencies", "scene_modes"]
 
@@ -97,6 +99,32 @@ def scene_modes(scenario: Scenario) -> ModeSet:
         mbs.Assemble()
         freqs, shapes = _eigen(mbs)
         return ModeSet(freqs, shapes, ["deflection"], (k_mean,))
+    if scenario.has_planetary:
+        return compound_modes(scenario)
     return natural_frequencies(
         torsional_layout(scenario), lateral_u0=static_lateral_displacements_m(scenario, 1.0)
     )
+
+
+def compound_modes(scenario: Scenario) -> ModeSet:
+    """Modes of a drive with planetary stages at the nominal assembly, every mesh at its mean stiffness
+    (exact geometry linearised by Exudyn: Lin & Parker's model for a planetary stage, no gyroscopic
+    terms), motor and load free."""
+    layout = compound_layout(scenario, modal=True)
+    n = len(layout.dof_names)
+    built = build_compound(layout, np.zeros(n), np.zeros(n), sensors=False, modal=True)
+    freqs, shapes = _eigen(built.mbs)
+    masses = np.zeros(n)
+    masses[list(layout.rotation_bodies)] = layout.inertias
+    k_mesh = [mean_stiffness_N_per_m(m.parameters) for m in layout.meshes]
+    for link in layout.planetary:
+        members = (*link.layout.members, *([link.layout.planet] * (len(link.names) - 3)))
+        for m, member in enumerate(members):
+            o = link.first + 3 * m
+            masses[o : o + 3] = (member.mass_kg, member.mass_kg, member.inertia_kg_m2)
+        k_mesh += [
+            mean_stiffness_N_per_m(link.layout.sun_mesh),
+            mean_stiffness_N_per_m(link.layout.ring_mesh),
+        ]
+    # Exudyn orders the system's coordinates node by node, as the layout lists them
+    return ModeSet(freqs, shapes, list(layout.dof_names), tuple(k_mesh), masses)
