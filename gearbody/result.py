@@ -168,6 +168,8 @@ class Result:
         speed, solver statistics and bearing forces; whole-run values say so by having no '_final'."""
         from .analysis import separation_stats
 
+        if self.planetary_stages:
+            return self._planetary_summary()
         win = self.final_window()
         sep = separation_stats(self.mesh_force, self.time_s, kd=self.kd)
         speed = (
@@ -211,6 +213,58 @@ class Result:
             },
         }
 
+    @property
+    def planetary_stages(self) -> list[int]:
+        """Indices of the planetary stages (0-based)."""
+        return [k for k, st in enumerate(self.meta.get("stages") or []) if st.get("type") == "planetary"]
+
+    def _planetary_summary(self) -> dict[str, Any]:
+        """summary() of a drive with planetary stages: per stage the planets' mesh K_d (largest, smallest,
+        final mean), the load-sharing factor (largest final mean planet force over the stage's mean), the
+        separations; parallel stages' K_d; speed and solver statistics."""
+        from .analysis import separation_stats
+
+        win = self.final_window()
+        stats = self.meta.get("solver_statistics", {})
+        t = float(self.time_s[-1] - self.time_s[0])
+        out: dict[str, Any] = {"scene": self.meta.get("scene")}
+        for k, meta in enumerate(self.meta["stages"]):
+            prefix = "" if k == 0 else f"stage_{k + 1}_"
+            if meta.get("type") != "planetary":
+                kd = self[prefix + "kd"]
+                out[f"{prefix}kd_max"], out[f"{prefix}kd_min"] = float(np.max(kd)), float(np.min(kd))
+                out[f"{prefix}kd_mean_final"] = float(np.mean(kd[win]))
+                continue
+            for mesh in ("sun", "ring"):
+                names = [f"{prefix}planet_{p + 1}_{mesh}_mesh" for p in range(meta["planets"])]
+                kd = np.array([self[n + "_kd"] for n in names])
+                means = kd[:, win].mean(axis=1)
+                seps = [
+                    separation_stats(self[n + "_force_N"], self.time_s, kd=self[n + "_kd"]) for n in names
+                ]
+                out[f"{prefix}{mesh}_mesh_kd_max"] = float(kd.max())
+                out[f"{prefix}{mesh}_mesh_kd_min"] = float(kd.min())
+                out[f"{prefix}{mesh}_mesh_kd_mean_final"] = float(means.mean())
+                out[f"{prefix}{mesh}_mesh_load_sharing_factor"] = float(means.max() / means.mean())
+                out[f"{prefix}{mesh}_mesh_separation_fraction"] = float(
+                    max(s.separated_fraction for s in seps)
+                )
+                out[f"{prefix}{mesh}_mesh_contact_losses"] = int(sum(s.contact_losses for s in seps))
+            out[f"{prefix}mesh_frequency_hz"] = float(np.mean(self[prefix + "mesh_frequency_hz"][win]))
+            out[f"{prefix}rated_mesh_force_N"] = float(meta["rated_mesh_force_N"])
+        out.update(
+            {
+                "mean_speed_rad_s": float(np.mean(self["motor_speed_rad_s"][win])),
+                "simulated_time_s": t,
+                "wall_time_s": float(stats.get("wall_time_s", float("nan"))),
+                "wall_s_per_simulated_s": float(stats.get("wall_time_s", float("nan"))) / max(t, 1e-300),
+                "solver_steps": int(stats.get("steps", 0)),
+                "solver_rejected_steps": int(stats.get("rejected_steps", 0)),
+                "seed": self.meta.get("seed"),
+            }
+        )
+        return out
+
     def period_boundaries_s(self) -> tuple[float, ...]:
         """The run's operating periods: its start, every breakpoint of the speed and load profiles inside
         the run, its end [s] (the four-period runs: 0, run-up end, load start, load rated, t_end)."""
@@ -251,6 +305,10 @@ class Result:
         from .plotting.run import write_plots
 
         Path(out_dir).mkdir(parents=True, exist_ok=True)
+        if self.planetary_stages:
+            from .plotting.planetary import write_planetary_plots
+
+            return write_planetary_plots(self, out_dir)
         return write_plots(self, out_dir)
 
     def _stage(self, stage: int) -> dict[str, Any]:

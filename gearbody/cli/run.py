@@ -56,6 +56,15 @@ def register(sub) -> argparse.ArgumentParser:
     return run
 
 
+PLANETARY_SHOWN = (
+    "kd_max",
+    "kd_mean_final",
+    "load_sharing_factor",
+    "separation_fraction",
+    "mesh_frequency_hz",
+)
+
+
 def execute(args) -> int:
     out = check_out(args.out or default_out(args.scene))  # before anything is imported or run
     from gearbody.engine import simulate
@@ -77,7 +86,7 @@ def execute(args) -> int:
         write_report(result, out / "report.html")
     if not args.quiet:
         print(f"{scenario.meta.title}")
-        for key in (
+        keys = (
             "kd_max",
             "kd_max_final",
             "kd_mean_final",
@@ -86,9 +95,13 @@ def execute(args) -> int:
             "mean_speed_rad_s",
             "simulated_time_s",
             "wall_time_s",
-        ):
+        )
+        if result.planetary_stages:  # per mesh type: K_d, sharing, separation
+            keys = tuple(k for k in summary if k.endswith(PLANETARY_SHOWN) or k in keys)
+        for key in keys:
             v = summary[key]
-            print(f"  {key:22s} {v:.4g}" if isinstance(v, float) else f"  {key:22s} {v}")
+            width = max(22, *(len(k) for k in keys))
+            print(f"  {key:{width}s} {v:.4g}" if isinstance(v, float) else f"  {key:{width}s} {v}")
         print(
             f"wrote {out}/result.npz, scenario.toml, summary.json"
             + (f", {len(plots)} plots" if plots else "")

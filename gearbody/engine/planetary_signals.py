@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from ..analysis.planet_pass import HannPassWindow, ring_sensor_signal
 from ..assembly.compound import PlanetaryLink, compound_layout
 from ..assembly.planetary_layout import CENTRAL
 from ..model import Scenario
@@ -76,7 +77,21 @@ def planetary_signals(scenario: Scenario, names: list[str], q, v, a) -> dict[str
                 out[f"{name}_bearing_force_{axis}_N"] = force  # on the housing
         w = {c: v[names.index(link.names[m])] for m, c in enumerate(CENTRAL)}
         out[prefix + "mesh_frequency_hz"] = st.sun.teeth * np.abs(w["sun"] - w["carrier"]) / (2 * math.pi)
+        out[prefix + "ring_sensor_N"] = _ring_sensor(link, st, names, q, out, prefix)
     return out
+
+
+def _ring_sensor(link: PlanetaryLink, st: PlanetaryStage, names, q, signals, prefix: str) -> np.ndarray:
+    """The ring-fixed sensor (docs/planetary.md, "Signals"): every planet's ring-mesh force weighted by
+    the Hann planet-pass window of the planet's angle from the sensor in the ring's frame,
+    theta_c + psi_n - theta_r - sensor angle (analysis.planet_pass.ring_sensor_signal)."""
+    theta_c = q[names.index(link.names[2])]
+    theta_r = q[names.index(link.names[1])]
+    psi = np.array([theta_c + a - theta_r for a in link.layout.planet_angles_rad])
+    forces = np.array([signals[f"{prefix}planet_{n + 1}_ring_mesh_force_N"] for n in range(st.planets)])
+    window = HannPassWindow(math.radians(st.sensor_window_deg))
+    t = np.arange(psi.shape[1], dtype=float)  # the sum does not depend on the times
+    return ring_sensor_signal(t, psi, forces, math.radians(st.sensor_angle_deg), window).signal_N
 
 
 def _planet_bearing(link: PlanetaryLink, names, q, n: int, planet: str) -> dict[str, np.ndarray]:

@@ -20,8 +20,15 @@ from ..physics.mesh import I_LU, I_Z1, mesh_breakpoint_phases, mesh_gap_series
 __all__ = ["OVERSAMPLING", "CubicHermite", "integer_crossings", "is_band_limited", "mesh_jump_times"]
 
 
-BAND_LIMITED_SUFFIXES = ("_accel_rad_s2", "_accel_m_s2", "_bearing_force_x_N", "_bearing_force_y_N")
-"""Signals replaced by their band-limited samples (accelerations, bearing and housing signals)."""
+BAND_LIMITED_SUFFIXES = (
+    "_accel_rad_s2",
+    "_accel_m_s2",
+    "_bearing_force_x_N",
+    "_bearing_force_y_N",
+    "ring_sensor_N",
+)
+"""Signals replaced by their band-limited samples (accelerations, bearing, housing and ring-sensor
+signals)."""
 
 
 def integer_crossings(t_s: np.ndarray, u: np.ndarray) -> np.ndarray:

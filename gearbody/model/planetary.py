@@ -71,6 +71,15 @@ class PlanetaryStage(Node):
     carrier: PlanetaryMember
     sun_mesh: PlanetaryMesh
     ring_mesh: PlanetaryMesh
+    sensor_angle_deg: float = param(
+        0.0,
+        ge=-360,
+        le=360,
+        doc="angle of the ring-fixed vibration sensor (ring_sensor_N), from planet 1's nominal place",
+    )
+    sensor_window_deg: float = param(
+        360.0, gt=0, le=360, doc="full width of the Hann planet-pass window of that sensor"
+    )
     sun_error_mode: ErrorMode = param(default_factory=ErrorMode, doc="E(a, e, r) on the sun's teeth")
     ring_error_mode: ErrorMode = param(default_factory=ErrorMode, doc="E(a, e, r) on the ring's teeth")
 
