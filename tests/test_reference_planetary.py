@@ -6,14 +6,17 @@ from __future__ import annotations
 
 import copy
 import math
+import pathlib
 
 import numpy as np
 import pytest
 
 try:  # the installed name of validation/ (a worktree's editable install may point elsewhere)
+    from gearbody_validation import reference as ref
     from gearbody_validation.reference import planetary as rp
     from gearbody_validation.reference import planetary_model as pm
 except ImportError:  # pragma: no cover
+    from validation import reference as ref
     from validation.reference import planetary as rp
     from validation.reference import planetary_model as pm
 
@@ -220,3 +223,101 @@ def test_stage_agrees_with_gearbody_prototype(teeth):
             key = f"planet_{n}_{kind}_mesh_force_N"
             assert np.max(np.abs(gb[key])) > 0.5 * F0  # loaded
             assert np.max(np.abs(ref[key] - gb[key])) < 5e-3 * F0, key
+
+
+# ---------------------------------------------------------------------------------------------------------
+# The drive: motor -> shafts -> planetary / parallel stages -> machine
+# ---------------------------------------------------------------------------------------------------------
+SCEN = pathlib.Path(__file__).resolve().parents[1] / "validation" / "scenarios"
+
+
+def two_stage(t_end: float) -> dict:
+    sc = copy.deepcopy(ref.load_scenario(SCEN / "two-stage-steady.toml"))
+    sc["condition"]["friction_coefficient"] = 0.0
+    sc["operation"]["t_end_s"] = t_end
+    return sc
+
+
+def planetary_drive(inp="sun", out="carrier", T_in=300.0, t_end=0.005, k=(4e8, 4e8), second=False) -> dict:
+    """The contract's example stage between the two-stage scene's motor (150 rad/s) and machine, its
+    rated torque set so that the input member carries T_in; optionally followed by that scene's stage 2."""
+    sc = two_stage(t_end)
+    par = sc["design"]["stages"][1]
+    st = stage_dict(k=k)
+    st["input"], st["output"] = inp, out
+    fixed = ({"sun", "ring", "carrier"} - {inp, out}).pop()
+    st["ring"].pop("torsion_stiffness_Nm_per_rad")
+    st[fixed]["torsion_stiffness_Nm_per_rad"] = 1e8
+    P = pm.PlanetaryStage(st)
+    M = T_in * P.r_eq_out / P.r_eq_in
+    if second:
+        M *= par["wheel"]["base_radius_m"] / par["pinion"]["base_radius_m"]
+    sc["design"]["stages"] = [st, par] if second else [st]
+    sc["design"]["shafts"] = sc["design"]["shafts"][: 3 if second else 2]
+    sc["design"]["machine"]["rated_torque_Nm"] = M
+    sc["design"]["motor"]["synchronous_speed_rad_s"] = 150.0
+    return sc
+
+
+def test_drive_of_parallel_stages_is_the_train():
+    """With no planetary stage the drive is the reference's train (same law, other assembly): the two-stage
+    scene (backlash 50 um, errors, friction off) for 20 ms."""
+    sc = two_stage(0.02)
+    a = ref.simulate_reference(sc)
+    b = rp.simulate_reference_drive(sc)
+    for s, key in enumerate(("mesh_force_N", "stage_2_mesh_force_N")):
+        assert np.max(np.abs(a["stage_mesh_force_N"][s] - b[key])) < 1e-6 * b["F_rated_N"][s]
+    assert np.max(np.abs(a["coordinates"] - b["coordinates"])) < 1e-9
+
+
+@pytest.mark.parametrize(
+    "inp, out",
+    [("sun", "carrier"), ("carrier", "sun"), ("sun", "ring"), ("ring", "sun"), ("ring", "carrier")],
+)
+def test_drive_steady_start_is_the_rated_load(inp, out):
+    """Steady start: every planet mesh at F_rated (kd = 1) with the turning sense of the contract; with
+    the carrier fixed (no circling planets) and constant mesh stiffness it stays there."""
+    sc = planetary_drive(inp, out, t_end=0.002 if "carrier" in (inp, out) else 0.005)
+    res = rp.simulate_reference_drive(sc)
+    kd = np.array([v for key, v in res.items() if key.endswith("_mesh_kd")])
+    assert kd.shape[0] == 6
+    assert np.max(np.abs(kd[:, 0] - 1.0)) < 1e-9
+    v = res["velocities"]
+    assert v[0, 0] > 0.0 and v[-1, 0] > 0.0  # motor and machine turn forward
+    P = pm.PlanetaryStage(sc["design"]["stages"][0])
+    assert v[-1, 0] == pytest.approx(v[0, 0] / abs(P.ratio), rel=1e-12)
+    if "carrier" not in (inp, out):
+        assert np.max(np.abs(kd - 1.0)) < 1e-6
+
+
+def test_drive_steady_start_ignores_the_planets_centripetal_load():
+    """The contract's steady start has no centripetal terms: sun input at ~150 rad/s, carrier at ~31 rad/s,
+    m_p w_c^2 r_c = 144 N per planet, and the mesh forces swing by a few % of F_rated (measured 2.8 %)."""
+    res = rp.simulate_reference_drive(planetary_drive("sun", "carrier"))
+    kd = np.array([v for key, v in res.items() if key.endswith("_mesh_kd")])
+    assert 0.01 < np.max(np.abs(kd - 1.0)) < 0.05
+
+
+def test_drive_two_stage_signals_and_rest_start():
+    sc = planetary_drive(second=True, t_end=0.002)
+    res = rp.simulate_reference_drive(sc)
+    assert "planet_3_ring_mesh_force_N" in res and "stage_2_mesh_force_N" in res and "stage_2_kd" in res
+    assert res["F_rated_N"][0] == pytest.approx(
+        300.0 / (3 * pm.PlanetaryStage(sc["design"]["stages"][0]).r_bs)
+    )
+    assert abs(res["stage_2_kd"][0] - 1.0) < 1e-9 and abs(res["planet_1_sun_mesh_kd"][0] - 1.0) < 1e-9
+    sc["operation"]["initial_state"] = "rest"
+    sc["operation"]["speed_profile"] = {"time_s": [0.0, 1.0], "fraction": [0.0, 1.0]}
+    res = rp.simulate_reference_drive(sc, t_eval=np.linspace(0.0, 0.002, 5))
+    assert np.all(np.isfinite(res["planet_2_sun_mesh_force_N"]))
+    assert np.all(res["sun_q"][0] == [0.0, 0.0, 0.0])
+    sc["condition"]["friction_coefficient"] = 0.05
+    with pytest.raises(ValueError, match="friction"):
+        rp.simulate_reference_drive(sc)
+
+
+def test_random_tooth_errors_use_the_stage_and_member_draw():
+    st = pm.PlanetaryStage(stage_dict(e_um=10.0, r=0.3), seed=4, stage_index=2)
+    for kind, key, z in (("sun", 1, 21), ("ring", 2, 81)):
+        l_rand = np.random.default_rng([4, 2, key]).random(z)
+        assert np.array_equal(st.laws[kind].e_amp, (1.0 - 0.3 * (1.0 - l_rand)) * 10.0 * 1e-6)
