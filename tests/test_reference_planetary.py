@@ -180,15 +180,39 @@ def test_refusals():
         pm.PlanetaryStage(bad)
 
 
-@pytest.mark.parametrize("teeth", [(21, 30, 81), (22, 29, 80)], ids=["in-phase", "sequential"])
-def test_stage_agrees_with_gearbody_prototype(teeth):
-    """The same stage in both models, suddenly loaded at rigid rolling: per-mesh forces within 0.5 % of
-    F = T / (N r_bs) over 0.01 s (measured: ~1e-7; ~2 s each, so not marked slow)."""
+def on_a_jump(st, res, lu_m: float) -> dict:
+    """Per mesh key, the samples within 1e-6 of a mesh period of a phase break point or within 1 nm of the
+    backlash edge: the sampled force jumps there, and which side a sample falls on is decided by state
+    differences far below the tolerances (Exudyn's steps cluster at every jump)."""
+    geo = st.mesh_geometry(res["coordinates"], res["velocities"])
+    out = {}
+    for n in range(st.N):
+        for kind in ("sun", "ring"):
+            law = st.laws[kind]
+            p = np.mod(geo[kind][4][n] * law.cz, 1.0)
+            dist = np.min(np.abs((p[:, None] - law.bA[None, :] + 0.5) % 1.0 - 0.5), axis=1)
+            edge = np.abs(np.abs(geo[kind][0][n]) - lu_m) < 1e-9
+            out[f"planet_{n + 1}_{kind}_mesh_force_N"] = (dist < 1e-6) | edge
+    return out
+
+
+@pytest.mark.parametrize(
+    "teeth, backlash_um",
+    [((21, 30, 81), 0.0), ((22, 29, 80), 0.0), ((22, 29, 80), 10.0)],
+    ids=["in-phase", "sequential", "sequential-separating"],
+)
+def test_stage_agrees_with_gearbody_prototype(teeth, backlash_um):
+    """The same stage in both models, suddenly loaded at rigid rolling (with backlash: the teeth
+    separate and strike again): per-mesh forces within 0.5 % of F = T / (N r_bs) over 0.01 s, away from
+    the jumps of the law (measured over 0.02 s: 6.6e-8, 9.8e-8; separating 6.3e-5, 16 % of the mesh
+    samples separated; ~2-4 s each, so not marked slow)."""
     from gearbody.assembly.planetary_layout import PlanetaryMember, layout_from_geometry
     from gearbody.engine.planetary import build_planetary, planetary_mesh_forces, solve_planetary
     from gearbody.physics.planetary import PlanetaryGeometry
 
     sd = stage_dict(*teeth)
+    for key in ("sun_mesh", "ring_mesh"):
+        sd[key]["backlash_um"] = backlash_um
     st = pm.PlanetaryStage(copy.deepcopy(sd))
     T, ws = 500.0, 100.0
     torques = {"sun": T, "carrier": -T * (1.0 + st.r_br / st.r_bs)}
@@ -203,12 +227,14 @@ def test_stage_agrees_with_gearbody_prototype(teeth):
         for name in ("sun", "ring", "carrier", "planet")
     }
     geometry = PlanetaryGeometry(*teeth, 3, 4e-3, 20.0)
+    lu = backlash_um * 1e-6
     layout = layout_from_geometry(
         geometry,
         **members,
         stiffness_single_N_per_m=(3e8, 3e8),
         stiffness_double_N_per_m=(5e8, 5e8),
         damping_Ns_per_m=(500.0, 500.0),
+        backlash_m=(lu, lu),
     )
     wc = ws / st.ratio
     system = build_planetary(layout, torques_Nm=torques, sun_speed_rad_s=ws, carrier_speed_rad_s=wc)
@@ -218,11 +244,14 @@ def test_stage_agrees_with_gearbody_prototype(teeth):
         sd, torques_Nm=torques, sun_speed_rad_s=ws, carrier_speed_rad_s=wc, t_eval=states["time_s"]
     )
     F0 = T / (3 * st.r_bs)
-    for n in range(1, 4):
-        for kind in ("sun", "ring"):
-            key = f"planet_{n}_{kind}_mesh_force_N"
-            assert np.max(np.abs(gb[key])) > 0.5 * F0  # loaded
-            assert np.max(np.abs(ref[key] - gb[key])) < 5e-3 * F0, key
+    jumps = on_a_jump(st, ref, lu)
+    for key, on_jump in jumps.items():
+        assert np.max(np.abs(gb[key])) > 0.5 * F0  # loaded
+        assert np.mean(on_jump) < 0.1
+        assert np.max(np.abs(ref[key] - gb[key])[~on_jump]) < 5e-3 * F0, key
+    assert np.max(np.abs(ref["sun_q"] - states["sun_q"])) < 1e-8
+    if lu > 0.0:  # the teeth did separate
+        assert np.mean([np.mean(ref[key] == 0.0) for key in jumps]) > 0.05
 
 
 # ---------------------------------------------------------------------------------------------------------
