@@ -350,3 +350,19 @@ def test_random_tooth_errors_use_the_stage_and_member_draw():
     for kind, key, z in (("sun", 1, 21), ("ring", 2, 81)):
         l_rand = np.random.default_rng([4, 2, key]).random(z)
         assert np.array_equal(st.laws[kind].e_amp, (1.0 - 0.3 * (1.0 - l_rand)) * 10.0 * 1e-6)
+
+
+def test_static_sharing_with_tooth_errors():
+    """E(0.5, 10 um, 0.3) on the sun's and ring's teeth: the planets mesh different teeth, so they share
+    the load unequally, but the sun's torque balance holds exactly: sum_n F_sn r_bs = T."""
+    st = pm.PlanetaryStage(stage_dict(22, 29, 80, e_um=10.0, r=0.3))
+    T = 500.0
+    rb = st.r_br / st.r_bs
+    q = st.static_equilibrium(np.array([T, 0.0, -T * (1.0 + rb)]), theta_gauge=0.05)
+    z = np.zeros(st.n_dof)
+    modes = st.mesh_modes(q, z)
+    mcs = [law.mode_consts(*m) for law, m in zip(st.meshes, modes, strict=True)]
+    F = st.mesh_forces(st.mesh_geometry(q, z), mcs, modes)
+    assert sum(F["sun"]) * st.r_bs == pytest.approx(T, rel=1e-9)
+    assert sum(F["ring"]) * st.r_br == pytest.approx(T * rb, rel=1e-9)
+    assert np.ptp(F["sun"]) > 1e-3 * T / (st.N * st.r_bs)
