@@ -225,12 +225,17 @@ def _support_forces(link: PlanetaryLink, q_rel: np.ndarray) -> np.ndarray:
 
 
 def stage_static_displacements(
-    link: PlanetaryLink, input_torque_Nm: float, output_torque_Nm: float, input_angle_rad: float = 0.0
+    link: PlanetaryLink,
+    input_torque_Nm: float,
+    output_torque_Nm: float,
+    input_angle_rad: float = 0.0,
+    carrier_speed_rad_s: float = 0.0,
 ) -> np.ndarray:
     """Static equilibrium of a planetary stage (displacements from the nominal assembly) under the signed
-    external torques on its input and output members: exact deflections, the mesh laws at this state
-    without damping, no centripetal terms; the input rotation held at ``input_angle_rad`` (the gauge);
-    Newton from the nominal assembly (docs/planetary.md, "Initial state")."""
+    external torques on its input and output members and the planets' centrifugal forces m_p w_c^2
+    (c_n - c_c) of a carrier turning at ``carrier_speed_rad_s``: exact deflections, the mesh laws at this
+    state without damping; the input rotation held at ``input_angle_rad`` (the gauge); Newton from the
+    nominal assembly (docs/planetary.md, "Initial state")."""
     ref, G = link.reference(), link.geometry_rows()
     Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
     gauge = 3 * CENTRAL.index(link.input) + 2
@@ -239,12 +244,16 @@ def stage_static_displacements(
     torques[3 * CENTRAL.index(link.input) + 2] += input_torque_Nm
     torques[3 * CENTRAL.index(link.output) + 2] += output_torque_Nm
     zero = np.zeros(link.size)
+    w2 = link.layout.planet.mass_kg * carrier_speed_rad_s**2
 
     def residual(x: np.ndarray) -> np.ndarray:
         q = np.zeros(link.size)
         q[gauge] = input_angle_rad
         q[free] = x
         f = stage_forces(ref + q, zero, G, Ps, Pr) + _support_forces(link, q) + torques
+        c = ref + q
+        f[9::3] += w2 * (c[9::3] - c[6])
+        f[10::3] += w2 * (c[10::3] - c[7])
         return f[free]
 
     scale = max(abs(input_torque_Nm), abs(output_torque_Nm), 1.0)
@@ -297,13 +306,17 @@ def compound_initial_state(scenario: Scenario, layout: CompoundLayout) -> tuple[
             link = links[k]
             s_in, s_out = link.input_sense, link.output_sense
             o = link.first
-            q[o : o + link.size] = stage_static_displacements(
-                link, s_in * T_in, -s_out * force * st.output_arm_m, s_in * angle_in
-            )
             speeds = {}
             if w_in:
                 willis = st.speeds(w_in)
                 speeds = {m: s_in * willis.of(m) for m in CENTRAL} | {"planet": s_in * willis.planet_rad_s}
+            q[o : o + link.size] = stage_static_displacements(
+                link,
+                s_in * T_in,
+                -s_out * force * st.output_arm_m,
+                s_in * angle_in,
+                speeds.get("carrier", 0.0),
+            )
             for m, member in enumerate(CENTRAL):
                 v[o + 3 * m + 2] = speeds.get(member, 0.0)
             wc = speeds.get("carrier", 0.0)

@@ -95,8 +95,8 @@ def _ring_sensor(link: PlanetaryLink, st: PlanetaryStage, names, q, signals, pre
 
 
 def _planet_bearing(link: PlanetaryLink, names, q, n: int, planet: str) -> dict[str, np.ndarray]:
-    """Planet n's bearing deflection (centre minus its carrier point), radial and tangential in the
-    carrier frame, m."""
+    """Planet n's centre (absolute, fixed frame) and its bearing deflection (centre minus its carrier
+    point), radial and tangential in the carrier frame, m."""
     rc, psi = link.layout.carrier_radius_m, link.layout.planet_angles_rad[n]
     ic = names.index(link.names[2] + "_x")
     ip = names.index(planet + "_x")
@@ -106,6 +106,8 @@ def _planet_bearing(link: PlanetaryLink, names, q, n: int, planet: str) -> dict[
     ey = py + q[ip + 1] - (q[ic + 1] + rc * np.sin(theta))
     c, s = np.cos(theta), np.sin(theta)
     return {
+        f"{planet}_centre_x_m": px + q[ip],  # absolute, in the fixed frame
+        f"{planet}_centre_y_m": py + q[ip + 1],
         f"{planet}_bearing_radial_m": c * ex + s * ey,
         f"{planet}_bearing_tangential_m": -s * ex + c * ey,
     }

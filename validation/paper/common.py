@@ -41,8 +41,9 @@ class Claim:
         self.passed = bool(self.passed)  # numpy bools are not JSON
 
 
-def write_results(name: str, title: str, claims: list[Claim], notes: list[str], figures: list[Path],
-                  wall_s: float) -> Path:
+def write_results(
+    name: str, title: str, claims: list[Claim], notes: list[str], figures: list[Path], wall_s: float
+) -> Path:
     """Write results/<name>.md (claims table, figures, notes) and results/<name>.json."""
     RESULTS_DIR.mkdir(parents=True, exist_ok=True)
     lines = [f"## {title}", "", f"Script `validation/paper/{name}.py`, {wall_s:.0f} s wall.", ""]

@@ -101,11 +101,22 @@ def check(curves: dict[str, np.ndarray], e_values: np.ndarray, ax=None) -> tuple
                 f"{label}: stable-range fit K_d = {intercept:.3f} + {slope:.4f} e[um], R^2 = {r2:.4f} "
                 f"(e <= {e_values[stable].max():.0f} um); threshold e (K_d = 2): {thresholds[label]:.1f} um"
             )
-            claims.append(Claim("9", f"{label}: K_d grows linearly with e below the threshold",
-                                f"R^2 = {r2:.4f}, slope {slope:.4f} /um", r2 > 0.98 and slope > 0))
-        claims.append(Claim("9", f"{label}: above a threshold e the running is unstable (K_d > 2)",
-                            f"threshold {thresholds[label]:.1f} um (largest e {e_values.max():.0f} um)",
-                            np.isfinite(thresholds[label])))
+            claims.append(
+                Claim(
+                    "9",
+                    f"{label}: K_d grows linearly with e below the threshold",
+                    f"R^2 = {r2:.4f}, slope {slope:.4f} /um",
+                    r2 > 0.98 and slope > 0,
+                )
+            )
+        claims.append(
+            Claim(
+                "9",
+                f"{label}: above a threshold e the running is unstable (K_d > 2)",
+                f"threshold {thresholds[label]:.1f} um (largest e {e_values.max():.0f} um)",
+                np.isfinite(thresholds[label]),
+            )
+        )
     ta, tb = thresholds["a: E(0.1, e, 0)"], thresholds["b: E(0.5, e, 0)"]
     e_top = float(e_values.max())
 
@@ -116,8 +127,9 @@ def check(curves: dict[str, np.ndarray], e_values: np.ndarray, ax=None) -> tuple
     differs = (np.isfinite(ta) != np.isfinite(tb)) or (
         np.isfinite(ta) and np.isfinite(tb) and abs(ta - tb) > 0.1 * max(ta, tb)
     )
-    claims.append(Claim("9", "the threshold e depends on a (a = 0.1 vs 0.5)", f"{shown(ta)} vs {shown(tb)}",
-                        differs))
+    claims.append(
+        Claim("9", "the threshold e depends on a (a = 0.1 vs 0.5)", f"{shown(ta)} vs {shown(tb)}", differs)
+    )
     return claims, notes
 
 

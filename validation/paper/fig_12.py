@@ -38,8 +38,11 @@ over error-mode seeds 1-5 on the calibrated drive's fit cases, fig_12_prediction
 def run(a, e, r, c1, t_end):
     sc = load_scenario(
         "one-stage",
-        [f"production.error_mode={{a={a},e_um={e},r={r}}}", f"design.coupling.damping_Nms_per_rad={c1}",
-         f"operation.t_end_s={t_end}"],
+        [
+            f"production.error_mode={{a={a},e_um={e},r={r}}}",
+            f"design.coupling.damping_Nms_per_rad={c1}",
+            f"operation.t_end_s={t_end}",
+        ],
     )
     return simulate(sc)
 
@@ -71,22 +74,45 @@ def main(quick: bool = False) -> None:
         v = kd4[label]
         if paper in ("unstable", "stable"):
             agree = (v > 2.0) == (paper == "unstable")
-            claims.append(Claim("12", f"{label}: {paper}", f"K_d4 = {v:.2f}", agree,
-                                "K_d4 > 2" if paper == "unstable" else "K_d4 <= 2"))
+            claims.append(
+                Claim(
+                    "12",
+                    f"{label}: {paper}",
+                    f"K_d4 = {v:.2f}",
+                    agree,
+                    "K_d4 > 2" if paper == "unstable" else "K_d4 <= 2",
+                )
+            )
         else:
             p = float(paper)
             agree = abs(v - p) <= 0.25 * p
             claims.append(Claim("12", f"{label}: K_d4 = {paper}", f"K_d4 = {v:.2f}", agree, "within 25 %"))
     claims += [
-        Claim("12", "coupling damping C_1 = 1000 N m s lowers K_d (b -> c)", f"{k[1]:.2f} -> {k[2]:.2f}",
-              k[2] < k[1]),
-        Claim("12", "a larger e raises K_d (a -> b, c -> d)",
-              f"{k[0]:.2f} -> {k[1]:.2f}; {k[2]:.2f} -> {k[3]:.2f}", k[1] > k[0] and k[3] > k[2]),
-        Claim("12", "a smaller random scope r lowers K_d slightly (d -> e: 2.4 -> 2.3)",
-              f"{k[3]:.3f} -> {k[4]:.3f}", k[4] < k[3] - RESOLVED_KD_CHANGE,
-              f"by more than {RESOLVED_KD_CHANGE} (the seed scatter)"),
-        Claim("12", "moving the error apex to a = 0.1 raises K_d strongly (d -> f: 2.4 -> 4.7)",
-              f"{k[3]:.2f} -> {k[5]:.2f}", k[5] > 1.5 * k[3]),
+        Claim(
+            "12",
+            "coupling damping C_1 = 1000 N m s lowers K_d (b -> c)",
+            f"{k[1]:.2f} -> {k[2]:.2f}",
+            k[2] < k[1],
+        ),
+        Claim(
+            "12",
+            "a larger e raises K_d (a -> b, c -> d)",
+            f"{k[0]:.2f} -> {k[1]:.2f}; {k[2]:.2f} -> {k[3]:.2f}",
+            k[1] > k[0] and k[3] > k[2],
+        ),
+        Claim(
+            "12",
+            "a smaller random scope r lowers K_d slightly (d -> e: 2.4 -> 2.3)",
+            f"{k[3]:.3f} -> {k[4]:.3f}",
+            k[4] < k[3] - RESOLVED_KD_CHANGE,
+            f"by more than {RESOLVED_KD_CHANGE} (the seed scatter)",
+        ),
+        Claim(
+            "12",
+            "moving the error apex to a = 0.1 raises K_d strongly (d -> f: 2.4 -> 4.7)",
+            f"{k[3]:.2f} -> {k[5]:.2f}",
+            k[5] > 1.5 * k[3],
+        ),
     ]
     notes = [
         f"one-stage scene as shipped, four periods, t_end {t_end} s; K_d4 = max K_d for t >= {PERIOD_4_S} s.",

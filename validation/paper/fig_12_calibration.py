@@ -62,8 +62,12 @@ RECORD_DIR = RESULTS_DIR / "fig_12_calibration"  # the pre-registered fit's reco
 WORKERS = 2
 FIT_CASES = {"(a) E(0.5,12,0.3) C1=0": 1.8, "(d) E(0.5,20,0.3) C1=1000": 2.4}
 FIT_SIGMA = 0.1
-FITTED = ("design.pinion.inertia_kg_m2", "design.wheel.inertia_kg_m2", "design.mesh.damping_Ns_per_m",
-          "design.coupling.stiffness_Nm_per_rad")
+FITTED = (
+    "design.pinion.inertia_kg_m2",
+    "design.wheel.inertia_kg_m2",
+    "design.mesh.damping_Ns_per_m",
+    "design.coupling.stiffness_Nm_per_rad",
+)
 BUDGET, BATCH, POLISH_EVALUATIONS, SEED = 160, 2, 40, 18
 
 
@@ -78,36 +82,68 @@ class Bound:
 
 
 BOUNDS = (
-    Bound("design.motor.inertia_kg_m2", 0.8, 3.0,
-          "rotor of a 75 kW 6-pole induction motor: catalogue values ~0.015-0.03 kg m^2/kW (1.1-2.3 kg m^2), "
-          "widened for a fan/brake disc"),
-    Bound("design.coupling.stiffness_Nm_per_rad", 1.0e4, 3.0e5,
-          "k_1 = flexible (elastomer, tyre, pin-bush) coupling of 1-3 kN m nominal torque, 1e4-2e5 N m/rad "
-          "dynamic, in series with the pinion shaft (d 60 mm, 0.3 m: G J / L = 3.4e5 N m/rad)"),
-    Bound("design.pinion.inertia_kg_m2", 0.0205, 0.4,
-          "I_1p = the bare pinion (steel disc at the pitch radius, 0.0205 kg m^2) up to pinion + its shaft + "
-          "the coupling's pinion-side half (hub of a 1-3 kN m coupling: 0.05-0.3 kg m^2)"),
-    Bound("design.wheel.inertia_kg_m2", 1.0, 3.5,
-          "I_2p = the 88-tooth wheel (solid disc 1.73 kg m^2; a webbed wheel ~0.6 of it) with its hub and "
-          "shaft"),
-    Bound("design.output_shaft.stiffness_Nm_per_rad", 1.0e5, 3.0e6,
-          "k_2 = output shaft (d 80-120 mm, 0.5-1 m: G J / L = 3e5-1.6e6 N m/rad) with the output coupling "
-          "in series"),
-    Bound("design.machine.inertia_kg_m2", 5.0, 60.0,
-          "I_m = driven machine (conveyor drum, belt, pump) referred to the output shaft, from 0.5 times the "
-          "motor rotor reflected through the ratio squared (1.2 x 9.2 = 11 kg m^2) up to what the motor "
-          "runs up in the paper's 0.5 s (breakdown 1750 N m / 214 rad/s^2 = 8.2 kg m^2 at the motor: "
-          "I_m <= 60 kg m^2; the screening's first upper bound, 100, stalls the run-up)"),
-    Bound("design.mesh.damping_Ns_per_m", 3000.0, 50000.0,
-          "C_z = mesh damping ratio 0.03-0.17 of critical, 2 zeta sqrt(k_z m_red), for the reduced mass "
-          "of the gear pair between the bare gears (4 kg) and the heaviest pinion side above (20 kg)"),
+    Bound(
+        "design.motor.inertia_kg_m2",
+        0.8,
+        3.0,
+        "rotor of a 75 kW 6-pole induction motor: catalogue values ~0.015-0.03 kg m^2/kW (1.1-2.3 kg m^2), "
+        "widened for a fan/brake disc",
+    ),
+    Bound(
+        "design.coupling.stiffness_Nm_per_rad",
+        1.0e4,
+        3.0e5,
+        "k_1 = flexible (elastomer, tyre, pin-bush) coupling of 1-3 kN m nominal torque, 1e4-2e5 N m/rad "
+        "dynamic, in series with the pinion shaft (d 60 mm, 0.3 m: G J / L = 3.4e5 N m/rad)",
+    ),
+    Bound(
+        "design.pinion.inertia_kg_m2",
+        0.0205,
+        0.4,
+        "I_1p = the bare pinion (steel disc at the pitch radius, 0.0205 kg m^2) up to pinion + its shaft + "
+        "the coupling's pinion-side half (hub of a 1-3 kN m coupling: 0.05-0.3 kg m^2)",
+    ),
+    Bound(
+        "design.wheel.inertia_kg_m2",
+        1.0,
+        3.5,
+        "I_2p = the 88-tooth wheel (solid disc 1.73 kg m^2; a webbed wheel ~0.6 of it) with its hub and "
+        "shaft",
+    ),
+    Bound(
+        "design.output_shaft.stiffness_Nm_per_rad",
+        1.0e5,
+        3.0e6,
+        "k_2 = output shaft (d 80-120 mm, 0.5-1 m: G J / L = 3e5-1.6e6 N m/rad) with the output coupling "
+        "in series",
+    ),
+    Bound(
+        "design.machine.inertia_kg_m2",
+        5.0,
+        60.0,
+        "I_m = driven machine (conveyor drum, belt, pump) referred to the output shaft, from 0.5 times the "
+        "motor rotor reflected through the ratio squared (1.2 x 9.2 = 11 kg m^2) up to what the motor "
+        "runs up in the paper's 0.5 s (breakdown 1750 N m / 214 rad/s^2 = 8.2 kg m^2 at the motor: "
+        "I_m <= 60 kg m^2; the screening's first upper bound, 100, stalls the run-up)",
+    ),
+    Bound(
+        "design.mesh.damping_Ns_per_m",
+        3000.0,
+        50000.0,
+        "C_z = mesh damping ratio 0.03-0.17 of critical, 2 zeta sqrt(k_z m_red), for the reduced mass "
+        "of the gear pair between the bare gears (4 kg) and the heaviest pinion side above (20 kg)",
+    ),
 )
-RATING = Bound("motor_power_kW", 37.0, 110.0,
-               "rated power of the motor at 107 rad/s (one-stage: 75 kW, 700 N m). The pair (module 5, face "
-               "60 mm) carries 160 N/mm of face at 75 kW; 80-240 N/mm (37-110 kW, IEC sizes) is the range of "
-               "through-hardened to case-hardened industrial spur gears; at 37 kW the breakdown torque still "
-               "runs the drive up in 0.5 s. Scales the rated torque, the breakdown torque and the rotor "
-               "inertia (inertia per kW of the speed class) together")
+RATING = Bound(
+    "motor_power_kW",
+    37.0,
+    110.0,
+    "rated power of the motor at 107 rad/s (one-stage: 75 kW, 700 N m). The pair (module 5, face "
+    "60 mm) carries 160 N/mm of face at 75 kW; 80-240 N/mm (37-110 kW, IEC sizes) is the range of "
+    "through-hardened to case-hardened industrial spur gears; at 37 kW the breakdown torque still "
+    "runs the drive up in 0.5 s. Scales the rated torque, the breakdown torque and the rotor "
+    "inertia (inertia per kW of the speed class) together",
+)
 BOUND = {b.key: b for b in (*BOUNDS, RATING)}
 RATED_KW = 75.0
 SCALED_BY_RATING = {  # scene key: its one-stage value at RATED_KW
@@ -141,12 +177,20 @@ class Fit:
 
 
 FITS = {
-    "fig3": Fit("fig_12_calibration", FITTED, CALIBRATED_SCENE,
-                "Pre-registered fit: the Fig. 3 structure, the four screened parameters, motor at 75 kW."),
-    "rating": Fit("fig_12_calibration_rating", (*FITTED, RATING.key), "one-stage-calibrated-rating",
-                  "Variant, declared after the pre-registered fit left (d) 6 sigma short: same structure, "
-                  "subset and sigma, the motor's rating free as well (it sets F_rated, and K_d - 1 scales "
-                  "as k_z e / F_rated)."),
+    "fig3": Fit(
+        "fig_12_calibration",
+        FITTED,
+        CALIBRATED_SCENE,
+        "Pre-registered fit: the Fig. 3 structure, the four screened parameters, motor at 75 kW.",
+    ),
+    "rating": Fit(
+        "fig_12_calibration_rating",
+        (*FITTED, RATING.key),
+        "one-stage-calibrated-rating",
+        "Variant, declared after the pre-registered fit left (d) 6 sigma short: same structure, "
+        "subset and sigma, the motor's rating free as well (it sets F_rated, and K_d - 1 scales "
+        "as k_z e / F_rated).",
+    ),
 }
 
 
@@ -197,10 +241,14 @@ class _Evaluator:
         self.runs += len(jobs)
         out = []
         for n, p in enumerate(points):
-            row = kds[n * len(self.cases):(n + 1) * len(self.cases)]
+            row = kds[n * len(self.cases) : (n + 1) * len(self.cases)]
             out.append(None if any(k is None for k in row) else dict(zip(self.cases, row, strict=True)))
-            print(" ".join(f"{k.split('.')[-2 if '.' in k else 0]}={v:.4g}" for k, v in p.items()), "->",
-                  out[-1], flush=True)
+            print(
+                " ".join(f"{k.split('.')[-2 if '.' in k else 0]}={v:.4g}" for k, v in p.items()),
+                "->",
+                out[-1],
+                flush=True,
+            )
         return out
 
 
@@ -221,6 +269,7 @@ def identifiability(cache, params, tg, best: dict[str, float]) -> dict:
     """What the fit's Jacobian (its forward-difference points, read back from the evaluation record) says:
     the conditional 1-sigma of each parameter (the others held at the optimum: a lower bound) and the
     singular values in normalised coordinates (a zero: a direction the targets do not identify)."""
+
     def residual(features):
         return np.array([(features[t.feature] - t.value) / t.sigma for t in tg])
 
@@ -228,16 +277,22 @@ def identifiability(cache, params, tg, best: dict[str, float]) -> dict:
     r0 = residual(cache.values[cache.key(best)])
     columns, conditional = [], {}
     for p in params:
-        near = [(abs(pt[p.key] - best[p.key]), pt, f) for pt, f in points.values()
-                if pt[p.key] != best[p.key] and all(pt[q.key] == best[q.key] for q in params if q is not p)]
+        near = [
+            (abs(pt[p.key] - best[p.key]), pt, f)
+            for pt, f in points.values()
+            if pt[p.key] != best[p.key] and all(pt[q.key] == best[q.key] for q in params if q is not p)
+        ]
         _, pt, f = min(near, key=lambda item: item[0])
         d = (residual(f) - r0) / (pt[p.key] - best[p.key])  # per unit of the parameter
         conditional[p.key] = float(1.0 / np.linalg.norm(d)) if np.any(d) else float("inf")
         du = p.to_unit(pt[p.key]) - p.to_unit(best[p.key])
         columns.append((residual(f) - r0) / du)
     singular = np.linalg.svd(np.column_stack(columns), compute_uv=False)
-    return {"conditional_sigma": conditional, "singular_values_unit": [float(x) for x in singular],
-            "identified_directions": int(np.sum(singular > 1e-6 * singular[0]))}
+    return {
+        "conditional_sigma": conditional,
+        "singular_values_unit": [float(x) for x in singular],
+        "identified_directions": int(np.sum(singular > 1e-6 * singular[0])),
+    }
 
 
 def run_calibration(fit: Fit) -> dict:
@@ -247,28 +302,61 @@ def run_calibration(fit: Fit) -> dict:
 
     params, tg = parameters(fit), targets()
     record_dir = fit.record_dir
-    fp = fingerprint(scene_path(SCENE).read_text(), [vars(p) for p in params], [vars(t) for t in tg],
-                     BUDGET, BATCH, POLISH_EVALUATIONS, SEED, PERIOD_4_S, CASES)
+    fp = fingerprint(
+        scene_path(SCENE).read_text(),
+        [vars(p) for p in params],
+        [vars(t) for t in tg],
+        BUDGET,
+        BATCH,
+        POLISH_EVALUATIONS,
+        SEED,
+        PERIOD_4_S,
+        CASES,
+    )
     cache = EvaluationCache(record_dir / "evaluations.jsonl", fp)
     evaluator = _Evaluator(SCENE, FIT_CASES)
     t0 = time.perf_counter()
     try:
-        result = calibrate(evaluator, params, tg, budget=BUDGET, batch=BATCH, polish=True,
-                           polish_evaluations=POLISH_EVALUATIONS, seed=SEED, cache=cache)
+        result = calibrate(
+            evaluator,
+            params,
+            tg,
+            budget=BUDGET,
+            batch=BATCH,
+            polish=True,
+            polish_evaluations=POLISH_EVALUATIONS,
+            seed=SEED,
+            cache=cache,
+        )
     finally:
         evaluator.pool.shutdown()
     wall = time.perf_counter() - t0
     print(result.table())
     record = {
-        "fit": fit.name, "statement": fit.statement, "scene": SCENE, "writes_scene": fit.scene,
-        "fitted": list(fit.fitted), "targets": FIT_CASES, "sigma": FIT_SIGMA,
-        "parameters": result.parameters, "sigma_parameters": result.sigma,
-        "correlation": np.asarray(result.correlation).tolist(), "features": result.features,
-        "residuals": result.residuals, "cost": result.cost, "evaluations": result.evaluations,
-        "replayed": result.replayed, "simulations_this_run": evaluator.runs,
-        "simulations": result.evaluations * len(FIT_CASES), "wall_s_this_run": wall,
-        "history": result.history, "budget": BUDGET, "batch": BATCH,
-        "polish_evaluations": POLISH_EVALUATIONS, "seed": SEED, "workers": WORKERS,
+        "fit": fit.name,
+        "statement": fit.statement,
+        "scene": SCENE,
+        "writes_scene": fit.scene,
+        "fitted": list(fit.fitted),
+        "targets": FIT_CASES,
+        "sigma": FIT_SIGMA,
+        "parameters": result.parameters,
+        "sigma_parameters": result.sigma,
+        "correlation": np.asarray(result.correlation).tolist(),
+        "features": result.features,
+        "residuals": result.residuals,
+        "cost": result.cost,
+        "evaluations": result.evaluations,
+        "replayed": result.replayed,
+        "simulations_this_run": evaluator.runs,
+        "simulations": result.evaluations * len(FIT_CASES),
+        "wall_s_this_run": wall,
+        "history": result.history,
+        "budget": BUDGET,
+        "batch": BATCH,
+        "polish_evaluations": POLISH_EVALUATIONS,
+        "seed": SEED,
+        "workers": WORKERS,
         "bounds": {k: [b.lower, b.upper, b.reason] for k, b in BOUND.items()},
         **identifiability(cache, params, tg, result.parameters),
     }
@@ -345,7 +433,7 @@ def scene_text(fit: Fit, record: dict) -> str:
     values, sigma = record["parameters"], record["conditional_sigma"]
     keys = scene_values(values)
     lines = scene_path(SCENE).read_text().splitlines()
-    body = lines[next(i for i, line in enumerate(lines) if line.startswith("[")):]
+    body = lines[next(i for i, line in enumerate(lines) if line.startswith("[")) :]
     section, out = "", []
     for line in body:
         if line.startswith("["):
@@ -357,9 +445,11 @@ def scene_text(fit: Fit, record: dict) -> str:
         elif section == "meta" and key == "title":
             line = 'title = "One-stage gearbox system, Fig. 3, calibrated on the paper\'s Fig. 12 (a), (d)"'
         elif section == "meta" and line.startswith('  "Kloss'):
-            line += ("\n  \"identified from the paper's Fig. 12 (a), (d) by "
-                     f"validation/paper/fig_12_calibration.py ({', '.join(fit.fitted)} within stated "
-                     "bounds)\",")
+            line += (
+                "\n  \"identified from the paper's Fig. 12 (a), (d) by "
+                f"validation/paper/fig_12_calibration.py ({', '.join(fit.fitted)} within stated "
+                'bounds)",'
+            )
         out.append(line)
     identified = [
         f"# - {k} = {values[k]:.6g} (conditional 1 sigma {sigma[k]:.2g}), "
@@ -369,13 +459,21 @@ def scene_text(fit: Fit, record: dict) -> str:
     identified.append(
         f"# {len(FIT_CASES)} targets identify {record['identified_directions']} directions of these "
         f"{len(fit.fitted)} parameters:\n# the set is one point of a family that fits as well; the fit "
-        f"leaves (a), (d) at " + ", ".join(f"{v:.2f}" for v in record["features"].values())
-        + f" (chi^2/2 = {record['cost']:.3g}).")
+        f"leaves (a), (d) at "
+        + ", ".join(f"{v:.2f}" for v in record["features"].values())
+        + f" (chi^2/2 = {record['cost']:.3g})."
+    )
     if RATING.key in fit.fitted:
-        identified.append(_comment("(the rating sets " + ", ".join(
-            f"{k} = {v:.6g}" for k, v in keys.items() if k in SCALED_BY_RATING) + ")"))
-    header = SCENE_HEADER.format(record=fit.name, statement=_comment(fit.statement),
-                                 identified="\n".join(identified))
+        identified.append(
+            _comment(
+                "(the rating sets "
+                + ", ".join(f"{k} = {v:.6g}" for k, v in keys.items() if k in SCALED_BY_RATING)
+                + ")"
+            )
+        )
+    header = SCENE_HEADER.format(
+        record=fit.name, statement=_comment(fit.statement), identified="\n".join(identified)
+    )
     return header + "\n" + "\n".join(out) + "\n"
 
 

@@ -38,7 +38,7 @@ def fig_12_runs(scene: str) -> tuple[dict[str, float | None], dict[str, float | 
     jobs += [(scene, case_overrides(F_LABEL, e), {}) for e in FURTHER_E_UM]
     kds = run_batch(jobs)
     cases = dict(zip(CASES, kds[: len(CASES)], strict=True))
-    further = dict(zip((f"E(0.1,{e:g},0.3)" for e in FURTHER_E_UM), kds[len(CASES):], strict=True))
+    further = dict(zip((f"E(0.1,{e:g},0.3)" for e in FURTHER_E_UM), kds[len(CASES) :], strict=True))
     return cases, further
 
 
@@ -46,8 +46,13 @@ def _kd_claim(label: str, paper: str, v: float | None) -> Claim:
     if v is None:
         return Claim("12", f"{label}: {paper}", "run refused", False)
     if paper in ("unstable", "stable"):
-        return Claim("12", f"{label}: {paper}", f"K_d4 = {v:.2f}", (v > 2.0) == (paper == "unstable"),
-                     "K_d4 > 2" if paper == "unstable" else "K_d4 <= 2")
+        return Claim(
+            "12",
+            f"{label}: {paper}",
+            f"K_d4 = {v:.2f}",
+            (v > 2.0) == (paper == "unstable"),
+            "K_d4 > 2" if paper == "unstable" else "K_d4 <= 2",
+        )
     p = float(paper)
     return Claim("12", f"{label}: K_d4 = {paper}", f"K_d4 = {v:.2f}", abs(v - p) <= 0.25 * p, "within 25 %")
 
@@ -60,21 +65,38 @@ def fig_12_claims(k: dict[str, float], further: dict[str, float]) -> tuple[list[
     a, b, c, d, e, f = (k[label] if k[label] is not None else float("nan") for label in CASES)
     predicted += [
         Claim("12", "coupling damping C_1 = 1000 N m s lowers K_d (b -> c)", f"{b:.2f} -> {c:.2f}", c < b),
-        Claim("12", "a larger e raises K_d (a -> b, c -> d)", f"{a:.2f} -> {b:.2f}; {c:.2f} -> {d:.2f}",
-              b > a and d > c),
-        Claim("12", "a smaller random scope r lowers K_d slightly (d -> e: 2.4 -> 2.3)",
-              f"{d:.3f} -> {e:.3f}", e < d - RESOLVED_KD_CHANGE,
-              f"by more than {RESOLVED_KD_CHANGE} (the seed scatter)"),
-        Claim("12", "moving the error apex to a = 0.1 raises K_d strongly (d -> f: 2.4 -> 4.7)",
-              f"{d:.2f} -> {f:.2f}", f > 1.5 * d),
+        Claim(
+            "12",
+            "a larger e raises K_d (a -> b, c -> d)",
+            f"{a:.2f} -> {b:.2f}; {c:.2f} -> {d:.2f}",
+            b > a and d > c,
+        ),
+        Claim(
+            "12",
+            "a smaller random scope r lowers K_d slightly (d -> e: 2.4 -> 2.3)",
+            f"{d:.3f} -> {e:.3f}",
+            e < d - RESOLVED_KD_CHANGE,
+            f"by more than {RESOLVED_KD_CHANGE} (the seed scatter)",
+        ),
+        Claim(
+            "12",
+            "moving the error apex to a = 0.1 raises K_d strongly (d -> f: 2.4 -> 4.7)",
+            f"{d:.2f} -> {f:.2f}",
+            f > 1.5 * d,
+        ),
     ]
     vals = [v for v in further.values() if v is not None]
     same = len(vals) == len(further) and all(abs(v - f) <= FURTHER_TOLERANCE * f for v in vals)
-    predicted.append(Claim(
-        "12", "(f): if e is increased further, K_d does not change",
-        f"K_d4 {f:.2f} at e = 20 um; " + ", ".join(
-            f"{n}: {'refused' if v is None else f'{v:.2f}'}" for n, v in further.items()),
-        same, f"within {FURTHER_TOLERANCE:.0%} of (f)"))
+    predicted.append(
+        Claim(
+            "12",
+            "(f): if e is increased further, K_d does not change",
+            f"K_d4 {f:.2f} at e = 20 um; "
+            + ", ".join(f"{n}: {'refused' if v is None else f'{v:.2f}'}" for n, v in further.items()),
+            same,
+            f"within {FURTHER_TOLERANCE:.0%} of (f)",
+        )
+    )
     return fitted, predicted
 
 
@@ -121,8 +143,10 @@ def _mesh_damping_ratio(scene: str) -> tuple[float, float, list[float]]:
     """(damping ratio of the mesh, reduced mass kg, natural frequencies Hz) of a scene with C_1 = 0."""
     sc = load_scenario(scene)
     st = sc.stages[0]
-    m = 1.0 / (st.pinion.base_radius_m ** 2 / st.pinion.inertia_kg_m2
-               + st.wheel.base_radius_m ** 2 / st.wheel.inertia_kg_m2)
+    m = 1.0 / (
+        st.pinion.base_radius_m**2 / st.pinion.inertia_kg_m2
+        + st.wheel.base_radius_m**2 / st.wheel.inertia_kg_m2
+    )
     k = 0.5 * (st.mesh.stiffness_single_N_per_m + st.mesh.stiffness_double_N_per_m)
     zeta = st.mesh.damping_Ns_per_m / (2.0 * np.sqrt(k * m))
     return float(zeta), float(m), [float(f) for f in scene_modes(sc).frequencies_hz]
@@ -171,15 +195,21 @@ def predict_fit(fit: Fit, record: dict, quick: bool = False) -> tuple[list, list
     damping_check = _damping_check(fit.scene, zeta) if zeta < ZETA_RANGE[0] else None
     scatter = seed_scatter(fit.scene)
     RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    fig = _plot(kd, further, RESULTS_DIR / f"{fit.name}_kd4.png",
-                f"{fit.scene}: Fig. 12 cases (bars) and the paper's values (red)")
+    fig = _plot(
+        kd,
+        further,
+        RESULTS_DIR / f"{fit.name}_kd4.png",
+        f"{fit.scene}: Fig. 12 cases (bars) and the paper's values (red)",
+    )
     lines = _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, timer.s, fig)
     at = lines.index("#### Fitted claims (used in the fit: not evidence)")
     lines[at:at] = [
         f"Seed scatter of the fit cases (error-mode seeds {', '.join(map(str, SCATTER_SEEDS))}, "
-        f"{len(SCATTER_SEEDS) * len(FIT_CASES)} runs): K_d4 " + ", ".join(
-            f"{c.split(' ')[0]} {m:.2f} +- {sd:.3f}" for c, (m, sd) in scatter.items())
-        + f" (mean +- std); the fit's sigma {FIT_SIGMA} is the paper's read-off precision, not this.", ""]
+        f"{len(SCATTER_SEEDS) * len(FIT_CASES)} runs): K_d4 "
+        + ", ".join(f"{c.split(' ')[0]} {m:.2f} +- {sd:.3f}" for c, (m, sd) in scatter.items())
+        + f" (mean +- std); the fit's sigma {FIT_SIGMA} is the paper's read-off precision, not this.",
+        "",
+    ]
     if damping_check is not None:
         c_z, kd_fit = damping_check
         at = lines.index("#### Fitted claims (used in the fit: not evidence)")
@@ -188,8 +218,13 @@ def predict_fit(fit: Fit, record: dict, quick: bool = False) -> tuple[list, list
             f"the {ZETA_RANGE[0]} that the bound's reason states (the C_z bound was set for reduced masses "
             f"of 4-20 kg; it admits {zeta:.3f} at {m_red:.1f} kg). With C_z raised to the "
             f"ratio {ZETA_RANGE[0]} ({c_z:.0f} N s/m), the fit cases give K_d4 "
-            + ", ".join(f"{k.split(' ')[0]} {v:.2f}" if v is not None else f"{k.split(' ')[0]} refused"
-                        for k, v in kd_fit.items()) + " (2 runs).", ""]
+            + ", ".join(
+                f"{k.split(' ')[0]} {v:.2f}" if v is not None else f"{k.split(' ')[0]} refused"
+                for k, v in kd_fit.items()
+            )
+            + " (2 runs).",
+            "",
+        ]
     for c in fitted + predicted:
         print(f"[{'PASS' if c.passed else 'FAIL'}] {c.figure}: {c.claim} -- {c.measured}")
     return lines, fitted, predicted, {**kd, **further}
@@ -216,14 +251,21 @@ def predict(quick: bool = False) -> None:
         short = ", ".join(f"`{k.split('.')[-2] if '.' in k else k}`" for k in fit.fitted)
         summary.append(
             f"| `{fit.scene}` | {short} | "
-            + " | ".join(f"{v:.2f} ({FIT_CASES[c]}, {r:+.1f} sigma)" for (c, v), r in
-                         zip(record["features"].items(), record["residuals"].values(), strict=True))
+            + " | ".join(
+                f"{v:.2f} ({FIT_CASES[c]}, {r:+.1f} sigma)"
+                for (c, v), r in zip(record["features"].items(), record["residuals"].values(), strict=True)
+            )
             + f" | {record['cost']:.3g} | {sum(c.passed for c in predicted)} / {len(predicted)} | "
-            f"{sum(c.passed for c in n12)} / {len(n12)} |")
+            f"{sum(c.passed for c in n12)} / {len(n12)} |"
+        )
     parts = [
-        "## Calibrated drive: Fig. 12 by calibration, the other claims as predictions", "",
+        "## Calibrated drive: Fig. 12 by calibration, the other claims as predictions",
+        "",
         "| scene | fitted | (a) K_d4 fitted (paper) | (d) K_d4 fitted (paper) | chi^2/2 | predicted claims "
-        "passed | of them Fig. 12 |", "|---|---|---|---|---|---|---|", *summary, "",
+        "passed | of them Fig. 12 |",
+        "|---|---|---|---|---|---|---|",
+        *summary,
+        "",
     ]
     need_lines, need_kd = needs()
     parts += [*_reading(kds, need_kd), "", *bodies, *need_lines]
@@ -249,7 +291,8 @@ def _reading(kds: dict[str, dict], need_kd: dict[str, float | None]) -> list[str
             f"- Pre-registered fit (Fig. 3 structure, 75 kW): the search found no set inside the bounds that "
             f"reaches (d): the best leaves K_d4 (d) at {k[labels[3]]:.2f} against 2.4. C_1 "
             f"{'lowers' if k[labels[2]] < k[labels[1]] else 'does not lower'} K_d (b -> c "
-            f"{k[labels[1]]:.2f} -> {k[labels[2]]:.2f}); (f) {k[labels[5]]:.2f} against 4.7.")
+            f"{k[labels[1]]:.2f} -> {k[labels[2]]:.2f}); (f) {k[labels[5]]:.2f} against 4.7."
+        )
     if "rating" in kds:
         k = kds["rating"]
         out.append(
@@ -257,33 +300,44 @@ def _reading(kds: dict[str, dict], need_kd: dict[str, float | None]) -> list[str
             f"predicted at {k[labels[5]]:.2f} (paper 4.7); the rating ends at its lower bound and the wheel "
             f"inertia near its upper one (see its table: the data pull out of the plausible box); C_1 "
             f"{'lowers' if k[labels[2]] < k[labels[1]] else 'does not lower'} K_d (b -> c "
-            f"{k[labels[1]]:.2f} -> {k[labels[2]]:.2f}); (b) K_d4 {k[labels[1]]:.2f}.")
+            f"{k[labels[1]]:.2f} -> {k[labels[2]]:.2f}); (b) K_d4 {k[labels[1]]:.2f}."
+        )
     if kds:
         dr = {key: k[labels[4]] - k[labels[3]] for key, k in kds.items()}
         rs = ", ".join(f"{key}: {k[labels[3]]:.3f} -> {k[labels[4]]:.3f}" for key, k in kds.items())
-        further = "; ".join(f"{key}: {k[labels[5]]:.2f} / " + " / ".join(
-            f"{v:.2f}" for v in list(k.values())[len(labels):]) for key, k in kds.items())
-        out.append(f"- The r effect (d -> e): changes of {', '.join(f'{v:+.3f}' for v in dr.values())} "
-                   f"({rs}); a change below {RESOLVED_KD_CHANGE} (twice the seed scatter) is not "
-                   "evidence either way, so the claim needs a larger decrease.")
-        out.append(f"- (f)'s 'if e is increased further, K_d does not change': K_d4 at e = 20 / 25 / 30 um: "
-                   f"{further}.")
+        further = "; ".join(
+            f"{key}: {k[labels[5]]:.2f} / " + " / ".join(f"{v:.2f}" for v in list(k.values())[len(labels) :])
+            for key, k in kds.items()
+        )
+        out.append(
+            f"- The r effect (d -> e): changes of {', '.join(f'{v:+.3f}' for v in dr.values())} "
+            f"({rs}); a change below {RESOLVED_KD_CHANGE} (twice the seed scatter) is not "
+            "evidence either way, so the claim needs a larger decrease."
+        )
+        out.append(
+            f"- (f)'s 'if e is increased further, K_d does not change': K_d4 at e = 20 / 25 / 30 um: "
+            f"{further}."
+        )
     ok = [label.split(" ")[0] for label in labels if _within(need_kd.get(label), CASES[label][4])]
-    out.append(f"- Diagnostic (last table): with the error imposed as mesh deflection (heavy gears) the "
-               f"model gives {', '.join(ok) or 'none'} of the six cases within the claims' tolerances.")
+    out.append(
+        f"- Diagnostic (last table): with the error imposed as mesh deflection (heavy gears) the "
+        f"model gives {', '.join(ok) or 'none'} of the six cases within the claims' tolerances."
+    )
     return out
 
 
 def _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, predict_s, fig) -> list[str]:
     n_pass = sum(c.passed for c in predicted)
     lines = [
-        f"### {fit.scene}", "",
+        f"### {fit.scene}",
+        "",
         f"{fit.statement} Scripts `validation/paper/fig_12_calibration.py` (the fit: `--calibrate --fit "
         f"{next(k for k, f in FITS.items() if f is fit)}`) and `fig_12_predictions.py`; scene "
         f"`scenes/{fit.scene}.toml`. Calibration: {record['evaluations']} parameter points x "
         f"{len(FIT_CASES)} cases = {record['simulations']} simulations of 2 s, "
         f"{record['wall_s_total']:.0f} s wall on {record['workers']} workers (nevergrad TwoPointsDE, "
-        f"budget {record['budget']}, then least-squares polish); predictions {predict_s:.0f} s wall.", "",
+        f"budget {record['budget']}, then least-squares polish); predictions {predict_s:.0f} s wall.",
+        "",
         "| parameter | bounds | identified | conditional 1 sigma | reason for the bounds |",
         "|---|---|---|---|---|",
     ]
@@ -292,26 +346,36 @@ def _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, predic
             v, sd = record["parameters"][key], record["conditional_sigma"][key]
             lines.append(f"| `{key}` | {b.lower:g} - {b.upper:g} | {v:.4g} | {sd:.2g} | {b.reason} |")
         else:
-            lines.append(f"| `{key}` | {b.lower:g} - {b.upper:g} | not fitted (one-stage value) | - | "
-                         f"{b.reason} |")
-    active = [k for k in fit.fitted
-              if min(abs(np.log(record["parameters"][k] / BOUND[k].lower)),
-                     abs(np.log(BOUND[k].upper / record["parameters"][k]))) < 0.05]
+            lines.append(
+                f"| `{key}` | {b.lower:g} - {b.upper:g} | not fitted (one-stage value) | - | {b.reason} |"
+            )
+    active = [
+        k
+        for k in fit.fitted
+        if min(
+            abs(np.log(record["parameters"][k] / BOUND[k].lower)),
+            abs(np.log(BOUND[k].upper / record["parameters"][k])),
+        )
+        < 0.05
+    ]
     lines += [
         "",
         f"Fit cost chi^2/2 = {record['cost']:.3g}; K_d4 fitted (target): "
         + ", ".join(f"{k.split(' ')[0]} {v:.2f} ({FIT_CASES[k]})" for k, v in record["features"].items())
-        + "; residuals / sigma: " + ", ".join(f"{v:+.2f}" for v in record["residuals"].values())
+        + "; residuals / sigma: "
+        + ", ".join(f"{v:+.2f}" for v in record["residuals"].values())
         + f". {len(FIT_CASES)} targets identify {record['identified_directions']} directions of "
         f"{len(fit.fitted)} parameters (singular values in normalised coordinates "
         + ", ".join(f"{x:.3g}" for x in record["singular_values_unit"])
         + "): the values are one point of a family that fits as well; the conditional sigma holds the "
         "others at the optimum (the Jacobian pseudo-inverse of gearbody's CalibrationResult gives "
-        + ", ".join(f"{record['sigma_parameters'][k]:.2g}" for k in fit.fitted) + ")."
+        + ", ".join(f"{record['sigma_parameters'][k]:.2g}" for k in fit.fitted)
+        + ")."
         + (f" At a bound: {', '.join(active)}." if active else ""),
         "",
         f"Mesh damping ratio at the optimum {zeta:.3f} of critical (reduced mass {m_red:.1f} kg); natural "
-        "frequencies (C_1 = 0) " + ", ".join(f"{f:.1f}" for f in modes) + " Hz; mesh frequency 494 Hz.", "",
+        "frequencies (C_1 = 0) " + ", ".join(f"{f:.1f}" for f in modes) + " Hz; mesh frequency 494 Hz.",
+        "",
     ]
     lines += ["#### Fitted claims (used in the fit: not evidence)", "", *_table(fitted), ""]
     lines += [f"#### Predicted claims: {n_pass} / {len(predicted)} pass", "", *_table(predicted), ""]
@@ -321,7 +385,9 @@ def _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, predic
         "coupling): not one-stage claims, not rerun here (figs_06_08.py runs them on `two-wheel`).",
         "- Figs. 13-16 are rerun with the stiffness-factor series of figs_13_16.py on the calibrated scene "
         "(the geometry series is on `one-stage-geometry`, not calibrated).",
-        "", f"![{fig.stem}](results/{fig.name})", "",
+        "",
+        f"![{fig.stem}](results/{fig.name})",
+        "",
     ]
     return lines
 
@@ -355,8 +421,9 @@ def _steady_kd(overrides: list[str]) -> float | None:
     from gearbody.studies import steady_overrides
 
     try:
-        res = simulate(load_scenario("one-stage", [*steady_overrides(1.0, NEEDS_SETTLE_S + NEEDS_RECORD_S),
-                                                   *overrides]))
+        res = simulate(
+            load_scenario("one-stage", [*steady_overrides(1.0, NEEDS_SETTLE_S + NEEDS_RECORD_S), *overrides])
+        )
     except GearbodyError as exc:
         print("refused:", str(exc).splitlines()[0][:160])
         return None
@@ -373,8 +440,10 @@ def needs() -> tuple[list[str], dict[str, float | None]]:
     labels = list(CASES)
     sc = load_scenario("one-stage")
     st = sc.stages[0]
-    m_red = 1.0 / (st.pinion.base_radius_m ** 2 / NEEDS_INERTIA["design.pinion.inertia_kg_m2"]
-                   + st.wheel.base_radius_m ** 2 / NEEDS_INERTIA["design.wheel.inertia_kg_m2"])
+    m_red = 1.0 / (
+        st.pinion.base_radius_m**2 / NEEDS_INERTIA["design.pinion.inertia_kg_m2"]
+        + st.wheel.base_radius_m**2 / NEEDS_INERTIA["design.wheel.inertia_kg_m2"]
+    )
     k_mean = 0.5 * (st.mesh.stiffness_single_N_per_m + st.mesh.stiffness_double_N_per_m)
     c_z = NEEDS_DAMPING_RATIO * 2.0 * np.sqrt(k_mean * m_red)
     big = [f"{k}={v}" for k, v in NEEDS_INERTIA.items()] + [f"design.mesh.damping_Ns_per_m={c_z:.1f}"]
@@ -387,10 +456,13 @@ def needs() -> tuple[list[str], dict[str, float | None]]:
     rows = ["| case | paper | imposed-error estimate | steady run, heavy gears |", "|---|---|---|---|"]
     for label, v in zip(labels, kds, strict=True):
         a, e, r, _, paper = CASES[label]
-        rows.append(f"| {label} | {paper} | {imposed_error_kd((a, e, r)):.2f} | "
-                    f"{'refused' if v is None else f'{v:.2f}'} |")
+        rows.append(
+            f"| {label} | {paper} | {imposed_error_kd((a, e, r)):.2f} | "
+            f"{'refused' if v is None else f'{v:.2f}'} |"
+        )
     return [
-        "### What the paper's numbers need (diagnostic, not a calibration)", "",
+        "### What the paper's numbers need (diagnostic, not a calibration)",
+        "",
         "If the error is imposed as mesh deflection (the gears cannot follow it: the mesh mode far below "
         "the mesh frequency), K_d = 1 + k_z (e_max - mean E) / F_rated (the estimate column: the one-stage "
         "k_z, F_rated and the scene's random tooth depths). In the Fig. 3 structure at this geometry that "
@@ -400,5 +472,8 @@ def needs() -> tuple[list[str], dict[str, float | None]]:
         f"mode {f_mesh:.0f} Hz) and C_z = {c_z:.3g} N s/m (damping ratio {NEEDS_DAMPING_RATIO}, as "
         "one-stage's) in "
         f"steady rated running (such a drive could not run up in 0.5 s), max K_d over {NEEDS_RECORD_S} s "
-        f"after {NEEDS_SETTLE_S} s; {timer.s:.0f} s wall.", "", *rows, "",
+        f"after {NEEDS_SETTLE_S} s; {timer.s:.0f} s wall.",
+        "",
+        *rows,
+        "",
     ], dict(zip(labels, kds, strict=True))

@@ -62,25 +62,49 @@ def main(quick: bool = False) -> None:
     ax.legend()
     ax.grid(alpha=0.3)
     figs = [save_figure(fig, RESULTS_DIR / "figs_06_08_folded.png", 100)]
-    figs.append(plot_kd_against_speed(sweep, modes.frequencies_hz, RESULTS_DIR / "figs_06_08_kd_speed.png",
-                                      "two-wheel, E(0.5, 10, 0): K_d against speed, rated load"))
-    figs.append(plot_campbell(modes.frequencies_hz, z1, 1.6 * rated, RESULTS_DIR / "figs_06_08_campbell.png",
-                              title="two-wheel: Campbell diagram", operating_speed_rad_s=rated * 0.9857))
+    figs.append(
+        plot_kd_against_speed(
+            sweep,
+            modes.frequencies_hz,
+            RESULTS_DIR / "figs_06_08_kd_speed.png",
+            "two-wheel, E(0.5, 10, 0): K_d against speed, rated load",
+        )
+    )
+    figs.append(
+        plot_campbell(
+            modes.frequencies_hz,
+            z1,
+            1.6 * rated,
+            RESULTS_DIR / "figs_06_08_campbell.png",
+            title="two-wheel: Campbell diagram",
+            operating_speed_rad_s=rated * 0.9857,
+        )
+    )
 
     under, at_res, over = (kd_max[k] for k in cases)
     ok = np.isfinite(sweep.kd_max)
     f_peak = float(sweep.mesh_frequency_hz[ok][np.argmax(sweep.kd_max[ok])])
     claims = [
-        Claim("6-8", "peak K_d is largest at resonance",
-              f"K_d max under / at / over: {under:.2f} / {at_res:.2f} / {over:.2f}",
-              at_res > max(under, over)),
-        Claim("7", "at resonance the gearing is unstable, K_d > 2 (forces two times or more the rated)",
-              f"K_d max {at_res:.2f}", at_res > 2.0),
+        Claim(
+            "6-8",
+            "peak K_d is largest at resonance",
+            f"K_d max under / at / over: {under:.2f} / {at_res:.2f} / {over:.2f}",
+            at_res > max(under, over),
+        ),
+        Claim(
+            "7",
+            "at resonance the gearing is unstable, K_d > 2 (forces two times or more the rated)",
+            f"K_d max {at_res:.2f}",
+            at_res > 2.0,
+        ),
         Claim("6", "under resonance the run is stable (K_d < 2)", f"K_d max {under:.2f}", under < 2.0),
-        Claim("sweep", "the K_d peak of the speed sweep sits where f_z meets the mesh mode",
-              f"peak at f_z = {f_peak:.0f} Hz, mesh mode {f_mesh_mode:.0f} Hz "
-              f"(sweep step {np.diff(sweep.mesh_frequency_hz[ok]).mean():.0f} Hz)",
-              abs(f_peak - f_mesh_mode) <= 1.5 * np.diff(sweep.mesh_frequency_hz[ok]).mean()),
+        Claim(
+            "sweep",
+            "the K_d peak of the speed sweep sits where f_z meets the mesh mode",
+            f"peak at f_z = {f_peak:.0f} Hz, mesh mode {f_mesh_mode:.0f} Hz "
+            f"(sweep step {np.diff(sweep.mesh_frequency_hz[ok]).mean():.0f} Hz)",
+            abs(f_peak - f_mesh_mode) <= 1.5 * np.diff(sweep.mesh_frequency_hz[ok]).mean(),
+        ),
     ]
     notes = [
         f"two-wheel scene, E(0.5, 10, 0), rated load, steady start; settle {SETTLE_S} s, record {RECORD_S} s "

@@ -59,17 +59,31 @@ def main() -> None:
     # the event's angle: allow one pitch around the broken tooth's mesh (the response rings after it)
     offset = (peak_deg - tooth_deg + 180.0) % 360.0 - 180.0
     claims = [
-        Claim("10-11", "the TSA shows a once-per-revolution event at the broken tooth",
-              f"largest |difference| at {peak_deg:.1f} deg, broken tooth in mesh at {tooth_deg:.1f} deg "
-              f"(+-{pitch / 2:.1f})", -pitch / 2 <= offset <= 1.5 * pitch),
-        Claim("10-11", "the difference signal (what is not mesh-periodic) rises far above the healthy gear's",
-              f"RMS {rms_b:.3g} vs healthy {rms_h:.3g} rad/s^2 ({20 * np.log10(rms_b / rms_h):.0f} dB); "
-              f"FM4 {fm4_b:.2f}", rms_b > 10 * rms_h),
+        Claim(
+            "10-11",
+            "the TSA shows a once-per-revolution event at the broken tooth",
+            f"largest |difference| at {peak_deg:.1f} deg, broken tooth in mesh at {tooth_deg:.1f} deg "
+            f"(+-{pitch / 2:.1f})",
+            -pitch / 2 <= offset <= 1.5 * pitch,
+        ),
+        Claim(
+            "10-11",
+            "the difference signal (what is not mesh-periodic) rises far above the healthy gear's",
+            f"RMS {rms_b:.3g} vs healthy {rms_h:.3g} rad/s^2 ({20 * np.log10(rms_b / rms_h):.0f} dB); "
+            f"FM4 {fm4_b:.2f}",
+            rms_b > 10 * rms_h,
+        ),
     ]
-    notes = ["FM4 of the healthy gear is not meaningful here: with r = 0 its difference signal is "
-             "numerical residue only.", "Indicators (healthy | broken): " + ", ".join(
-        f"{k} {ind['healthy'][k]:.3g} | {ind['broken tooth (0.2 k_z)'][k]:.3g}"
-        for k in ind["healthy"] if isinstance(ind["healthy"][k], float))]
+    notes = [
+        "FM4 of the healthy gear is not meaningful here: with r = 0 its difference signal is "
+        "numerical residue only.",
+        "Indicators (healthy | broken): "
+        + ", ".join(
+            f"{k} {ind['healthy'][k]:.3g} | {ind['broken tooth (0.2 k_z)'][k]:.3g}"
+            for k in ind["healthy"]
+            if isinstance(ind["healthy"][k], float)
+        ),
+    ]
     title = "Figs. 10-11: synchronous average of a broken tooth"
     write_results("figs_10_11", title, claims, notes, figs, timer.s)
 

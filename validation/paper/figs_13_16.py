@@ -90,18 +90,31 @@ def _claims(series: str, wideband: dict, share: dict, lines: dict, failed: dict)
     values = [wideband[k] for k in damaged]
     f_z, f_p = lines[damaged[-1]]
     claims = [
-        Claim("13-16", f"{series}: wideband content grows with the tooth fracture " + " -> ".join(damaged),
-              " / ".join(f"{v:.3g}" for v in values) + f" rad/s^2 (healthy {wideband['healthy']:.3g})",
-              all(b > a for a, b in zip(values, values[1:], strict=False))
-              and values[0] > wideband["healthy"]),
-        Claim("13-16", f"{series}: its lines are spaced at the shaft frequency (pinion, the damaged gear)",
-              "share of the 40 strongest non-mesh peaks on multiples of f_pinion = "
-              + " / ".join(f"{share[k]:.2f}" for k in damaged) + f" (f_pinion {f_p:.2f} Hz)",
-              min(share[k] for k in damaged) >= 0.9),
+        Claim(
+            "13-16",
+            f"{series}: wideband content grows with the tooth fracture " + " -> ".join(damaged),
+            " / ".join(f"{v:.3g}" for v in values) + f" rad/s^2 (healthy {wideband['healthy']:.3g})",
+            all(b > a for a, b in zip(values, values[1:], strict=False)) and values[0] > wideband["healthy"],
+        ),
+        Claim(
+            "13-16",
+            f"{series}: its lines are spaced at the shaft frequency (pinion, the damaged gear)",
+            "share of the 40 strongest non-mesh peaks on multiples of f_pinion = "
+            + " / ".join(f"{share[k]:.2f}" for k in damaged)
+            + f" (f_pinion {f_p:.2f} Hz)",
+            min(share[k] for k in damaged) >= 0.9,
+        ),
     ]
     for label, message in failed.items():
-        claims.append(Claim("13-16", f"{series}: the {label} case runs", "simulation failed: " + message,
-                            False, "the pinion chatters across the edge of the missing tooth"))
+        claims.append(
+            Claim(
+                "13-16",
+                f"{series}: the {label} case runs",
+                "simulation failed: " + message,
+                False,
+                "the pinion chatters across the edge of the missing tooth",
+            )
+        )
     return claims
 
 

@@ -1,6 +1,6 @@
 """Run every reproduction script and regenerate validation/paper/RESULTS.md.
 
-    python -m gearbody_validation.paper.run_all [--quick]   (from a checkout: writes its validation/paper)
+python -m gearbody_validation.paper.run_all [--quick]   (from a checkout: writes its validation/paper)
 """
 
 from __future__ import annotations

@@ -193,8 +193,8 @@ def drive_initial_state(scenario: dict, system, blocks, Fr) -> np.ndarray:
             torques = np.zeros(3)
             torques[st.i_in] += st.s_in * T_in[s]
             torques[st.i_out] -= st.s_out * T_out
-            q = st.static_equilibrium(torques, theta_gauge=st.s_in * phi_in)
             wc = st.rigid_speeds(st.input, st.s_in * w)
+            q = st.static_equilibrium(torques, theta_gauge=st.s_in * phi_in, carrier_speed_rad_s=wc[2])
             y[b.sl] = q
             y[nd:][b.sl] = st.rigid_state(wc, q)
             phi_out, w = st.s_out * q[3 * st.i_out + 2], st.s_out * wc[st.i_out]

@@ -191,13 +191,14 @@ class PlanetaryStage:
 
     def rigid_state(self, w_central, q=None):
         """Velocities of rigid rolling at the central speeds (w_s, w_r, w_c): planets spin at
-        w_n = w_c - (r_bs / r_bp)(w_s - w_c), their centres move with w_c z x c_n (c_n from q)."""
+        w_n = w_c - (r_bs / r_bp)(w_s - w_c), their centres move with w_c z x (c_n - c_c) (positions
+        from q)."""
         q = self.q_nominal if q is None else q
         v = np.zeros(self.n_dof)
         ws, wr, wc = w_central
         v[2], v[5], v[8] = ws, wr, wc
         v[11::3] = wc - self.r_bs / self.r_bp * (ws - wc)
-        v[9::3], v[10::3] = -wc * q[10::3], wc * q[9::3]
+        v[9::3], v[10::3] = -wc * (q[10::3] - q[7]), wc * (q[9::3] - q[6])  # about the carrier centre
         return v
 
     def mesh_geometry(self, q, v):
@@ -304,11 +305,14 @@ class PlanetaryStage:
                 modes.append([nn, k, law.contact_mode(d, float(ddot[n]))])
         return modes
 
-    def static_equilibrium(self, torques, theta_gauge: float = 0.0, q_start=None) -> np.ndarray:
+    def static_equilibrium(
+        self, torques, theta_gauge: float = 0.0, q_start=None, carrier_speed_rad_s: float = 0.0
+    ) -> np.ndarray:
         """Static equilibrium (exact deflections, mesh laws without damping) under the external torques
-        (sun, ring, carrier), the input member's rotation held at ``theta_gauge``: Newton from the
-        nominal assembly (or q_start), the Jacobian by central differences in the modes of the iterate
-        (the locked law is smooth there, so a mode boundary next to the state cannot spoil it)."""
+        (sun, ring, carrier) and the planets' centrifugal forces m_p w_c^2 (c_n - c_c) of a carrier
+        turning at ``carrier_speed_rad_s``, the input member's rotation held at ``theta_gauge``: Newton
+        from the nominal assembly (or q_start), the Jacobian by central differences in the modes of the
+        iterate (the locked law is smooth there, so a mode boundary next to the state cannot spoil it)."""
         q = (self.q_nominal if q_start is None else q_start).copy()
         g = 3 * self.i_in + 2
         q[g] = theta_gauge
@@ -321,7 +325,10 @@ class PlanetaryStage:
             mcs = [law.mode_consts(nn, k, c) for law, (nn, k, c) in zip(self.meshes, modes, strict=True)]
             geo = self.mesh_geometry(qq, zero)
             Q = self.generalised_forces(qq, zero, geo, self.mesh_forces(geo, mcs, modes), damping=False)
-            return (Q + ext)[free]
+            centrifugal = np.zeros(self.n_dof)
+            w2 = self.mass[3] * carrier_speed_rad_s**2  # every planet's mass
+            centrifugal[9::3], centrifugal[10::3] = w2 * (qq[9::3] - qq[6]), w2 * (qq[10::3] - qq[7])
+            return (Q + ext + centrifugal)[free]
 
         for _it in range(40):
             modes = self.mesh_modes(q, zero)
