@@ -20,7 +20,8 @@ import numpy as np
 from ..errors import InputError
 from ..model import Scenario
 from ..model.planetary import PlanetaryStage
-from ..physics.planetary_mesh import stage_forces
+from ..physics.mesh import I_LU
+from ..physics.planetary_mesh import G_DELTA0_RING, G_DELTA0_SUN, stage_forces
 from .operating_point import static_deflection_m, steady_operating_point
 from .parameters import mesh_parameters_from_scenario, pack_drive_parameters
 from .planetary_layout import CENTRAL, PlanetaryLayout, layout_from_stage
@@ -236,8 +237,15 @@ def stage_static_displacements(
     (c_n - c_c) of a carrier turning at ``carrier_speed_rad_s``: exact deflections, the mesh laws at this
     state without damping; the input rotation held at ``input_angle_rad`` (the gauge); Newton from the
     nominal assembly (docs/planetary.md, "Initial state")."""
-    ref, G = link.reference(), link.geometry_rows()
-    Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
+    ref, G_true = link.reference(), link.geometry_rows()
+    Ps_true, Pr_true = link.layout.sun_mesh, link.layout.ring_mesh
+    # Solved on the loaded flanks: the backlash moved into the assembly deflection (delta - l_u with no
+    # clearance is the law's contact branch), so Newton starts from a law without a dead zone; the
+    # result is then checked with the true law (every loaded mesh on its flank).
+    G, Ps, Pr = G_true.copy(), Ps_true.copy(), Pr_true.copy()
+    G[:, G_DELTA0_SUN] += Ps[I_LU]
+    G[:, G_DELTA0_RING] += Pr[I_LU]
+    Ps[I_LU] = Pr[I_LU] = 0.0
     gauge = 3 * CENTRAL.index(link.input) + 2
     free = np.array([i for i in range(link.size) if i != gauge])
     torques = np.zeros(link.size)
@@ -272,6 +280,8 @@ def stage_static_displacements(
             J[:, j] = (residual(x + e) - residual(x - e)) / (2 * h)
         x = x - np.linalg.solve(J, r)
         r = residual(x)
+    G, Ps, Pr = G_true, Ps_true, Pr_true
+    r = residual(x)
     if not np.max(np.abs(r)) <= STATIC_TOLERANCE * scale:
         raise InputError(
             f"operation.initial_state = 'steady': stage {link.stage + 1}: no static equilibrium of the "

@@ -330,8 +330,14 @@ class PlanetaryStage:
             centrifugal[9::3], centrifugal[10::3] = w2 * (qq[9::3] - qq[6]), w2 * (qq[10::3] - qq[7])
             return (Q + ext + centrifugal)[free]
 
+        # Every mesh is first locked on its loaded flank (contact mode 1: F = k (d - l_u), a law without
+        # the backlash's dead zone, whose Jacobian at the unloaded start is regular); once converged the
+        # true contact modes take over and Newton goes on until the modes agree with the state.
+        locked = True
         for _it in range(40):
             modes = self.mesh_modes(q, zero)
+            if locked:
+                modes = [[nn, k, 1] for nn, k, _ in modes]
             r = resid(q, modes)
             J = np.empty((free.size, free.size))
             for c, i in enumerate(free):
@@ -343,7 +349,9 @@ class PlanetaryStage:
             dq = np.linalg.solve(J, -r)
             q[free] += dq
             if np.max(np.abs(dq)) <= 1e-11 * max(np.max(np.abs(q - self.q_nominal)), 1e-12):
-                return q
+                if not locked:
+                    return q
+                locked = False
         raise RuntimeError("static equilibrium: Newton did not converge")
 
     def one_mesh(self, q, n: int, kind: str):
