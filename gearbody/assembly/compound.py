@@ -202,7 +202,7 @@ def stage_stiffness_matrix(link: PlanetaryLink, step: float = 1e-7) -> np.ndarra
     the meshes are springs at their mean stiffness through zero deflection, so this is the exact
     geometry's linearisation (Lin & Parker's matrices in the fixed frame) to O(step^2)."""
     ref, G = link.reference(), link.geometry_rows()
-    Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
+    Ps, Pr = link.layout.mesh_arrays()
     zero = np.zeros(link.size)
     K = np.empty((link.size, link.size))
     for j in range(link.size):
@@ -238,14 +238,14 @@ def stage_static_displacements(
     state without damping; the input rotation held at ``input_angle_rad`` (the gauge); Newton from the
     nominal assembly (docs/planetary.md, "Initial state")."""
     ref, G_true = link.reference(), link.geometry_rows()
-    Ps_true, Pr_true = link.layout.sun_mesh, link.layout.ring_mesh
+    Ps_true, Pr_true = link.layout.mesh_arrays()
     # Solved on the loaded flanks: the backlash moved into the assembly deflection (delta - l_u with no
     # clearance is the law's contact branch), so Newton starts from a law without a dead zone; the
     # result is then checked with the true law (every loaded mesh on its flank).
     G, Ps, Pr = G_true.copy(), Ps_true.copy(), Pr_true.copy()
-    G[:, G_DELTA0_SUN] += Ps[I_LU]
-    G[:, G_DELTA0_RING] += Pr[I_LU]
-    Ps[I_LU] = Pr[I_LU] = 0.0
+    G[:, G_DELTA0_SUN] += Ps[..., I_LU]
+    G[:, G_DELTA0_RING] += Pr[..., I_LU]
+    Ps[..., I_LU] = Pr[..., I_LU] = 0.0
     gauge = 3 * CENTRAL.index(link.input) + 2
     free = np.array([i for i in range(link.size) if i != gauge])
     torques = np.zeros(link.size)

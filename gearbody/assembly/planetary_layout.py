@@ -74,20 +74,52 @@ class PlanetaryLayout:
     sun_mesh: np.ndarray = field(repr=False)
     ring_mesh: np.ndarray = field(repr=False)
     mesh_angle_offsets_rad: tuple[tuple[float, float], ...] = ()  # per planet (sun, ring); () = zeros
+    # faults (docs/planetary.md, "Faults"): per-planet packed laws (N x len, sun and ring meshes) when a
+    # planet's own teeth carry factors (None: every planet uses sun_mesh / ring_mesh), pin errors along
+    # the carrier circle (m) and factors on the planet bearings, one per planet (() = none)
+    planet_meshes: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+    pin_errors_m: tuple[float, ...] = ()
+    bearing_factors: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
-        if not self.planet_angles_rad:
+        n = len(self.planet_angles_rad)
+        if not n:
             raise ValueError("a planetary stage needs at least one planet")
-        if self.mesh_angle_offsets_rad and len(self.mesh_angle_offsets_rad) != len(self.planet_angles_rad):
+        if self.mesh_angle_offsets_rad and len(self.mesh_angle_offsets_rad) != n:
             raise ValueError("mesh_angle_offsets_rad needs one (sun, ring) pair per planet")
+        for name in ("pin_errors_m", "bearing_factors"):
+            if getattr(self, name) and len(getattr(self, name)) != n:
+                raise ValueError(f"{name} needs one value per planet")
+        if self.planet_meshes is not None and any(P.shape[0] != n for P in self.planet_meshes):
+            raise ValueError("planet_meshes need one packed law per planet")
 
     @property
     def members(self) -> tuple[PlanetaryMember, ...]:
         return (self.sun, self.ring, self.carrier)
 
+    def pin_angle_rad(self, n: int) -> float:
+        """Angle of planet n's pin on the carrier: psi_n plus its tangential error e_n / r_c."""
+        if self.pin_errors_m:
+            return self.planet_angles_rad[n] + self.pin_errors_m[n] / self.carrier_radius_m
+        return self.planet_angles_rad[n]
+
     def planet_centre_m(self, n: int) -> tuple[float, float]:
-        psi = self.planet_angles_rad[n]
+        """Planet n's reference centre: its pin, r_c (cos, sin)(psi_n + e_n / r_c)."""
+        psi = self.pin_angle_rad(n)
         return self.carrier_radius_m * math.cos(psi), self.carrier_radius_m * math.sin(psi)
+
+    def mesh_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """(sun, ring) laws for :func:`gearbody.physics.planetary_mesh.stage_forces`: the shared 1-D
+        arrays, or one row per planet."""
+        return (self.sun_mesh, self.ring_mesh) if self.planet_meshes is None else self.planet_meshes
+
+    def sun_mesh_of(self, n: int) -> np.ndarray:
+        """Packed sun-mesh law of planet n (0-based)."""
+        return self.sun_mesh if self.planet_meshes is None else self.planet_meshes[0][n]
+
+    def ring_mesh_of(self, n: int) -> np.ndarray:
+        """Packed ring-mesh law of planet n (0-based)."""
+        return self.ring_mesh if self.planet_meshes is None else self.planet_meshes[1][n]
 
     def geometry(self, n: int) -> np.ndarray:
         """The geometry array of planet n for :func:`gearbody.physics.planetary_mesh.planet_forces`."""
@@ -97,9 +129,12 @@ class PlanetaryLayout:
             self.base_radius_planet_m,
             self.base_radius_ring_m,
         )
-        G[G_CARRIER_RADIUS], G[G_PSI] = self.carrier_radius_m, self.planet_angles_rad[n]
+        G[G_CARRIER_RADIUS], G[G_PSI] = self.carrier_radius_m, self.pin_angle_rad(n)
         G[G_BEARING_K] = self.planet.bearing_stiffness_N_per_m
         G[G_BEARING_C] = self.planet.bearing_damping_Ns_per_m
+        if self.bearing_factors:
+            G[G_BEARING_K] *= self.bearing_factors[n]
+            G[G_BEARING_C] *= self.bearing_factors[n]
         if self.mesh_angle_offsets_rad:
             G[G_ANGLE_SUN], G[G_ANGLE_RING] = self.mesh_angle_offsets_rad[n]
         G[G_DELTA0_SUN], G[G_DELTA0_RING] = nominal_deflections_m(self, n)
@@ -107,9 +142,10 @@ class PlanetaryLayout:
 
 
 def nominal_deflections_m(layout: PlanetaryLayout, n: int) -> tuple[float, float]:
-    """(sun, ring) mesh deflections of planet n at the nominal assembly (every rotation 0)."""
-    x, y = layout.planet_centre_m(n)
+    """(sun, ring) mesh deflections of planet n at the nominal, error-free assembly (every rotation 0,
+    the planet at psi_n: a pin error preloads the meshes)."""
     psi = layout.planet_angles_rad[n]
+    x, y = layout.carrier_radius_m * math.cos(psi), layout.carrier_radius_m * math.sin(psi)
     planet = [x, y, 0.0]
     d_s = pair_deflection(
         np.array([0.0, 0.0, 0.0, *planet]), layout.base_radius_sun_m, layout.base_radius_planet_m, False, psi
@@ -162,12 +198,19 @@ def layout_from_geometry(
     pitch_point_phase: tuple[float, float] = (0.5, 0.5),
     error_a: tuple[float, float] = (0.0, 0.0),
     error_depths_m: tuple[np.ndarray | None, np.ndarray | None] = (None, None),
+    tooth_factors: tuple | None = None,
+    pin_errors_m: tuple[float, ...] = (),
+    bearing_factors: tuple[float, ...] = (),
 ) -> PlanetaryLayout:
     """A :class:`PlanetaryLayout` from a checked :class:`gearbody.physics.planetary.PlanetaryGeometry`:
     radii, planet angles, each mesh's contact ratio (:func:`contact_ratios` unless given) and the ring
     mesh's offset of half a mesh period when the planet has an even number of teeth
     (``planet_mesh_phases(...).ring_sun``). The pairs of mesh values are (sun mesh, ring mesh); the
-    error depths are per sun (ring) tooth, None for none. No friction or faults yet."""
+    error depths are per sun (ring) tooth, None for none. Faults (docs/planetary.md, "Faults"):
+    ``tooth_factors`` = (sun factors, ring factors, (planet 1 factors, ..., planet N)) per tooth, the
+    planets' in their sun-mesh numbering (each planet then gets its own laws, its ring mesh's wheel
+    factors shifted by M_n + floor(z_p / 2)); pin errors (m) and planet-bearing factors per planet. No
+    friction yet."""
     from ..physics.mesh import pack_mesh_parameters
     from ..physics.planetary import planet_mesh_phases
 
@@ -177,9 +220,13 @@ def layout_from_geometry(
     rbs, rbp, rbr = g.sun_base_radius_m, g.planet_base_radius_m, g.ring_base_radius_m
     widths = transition_width if isinstance(transition_width, tuple) else (transition_width,) * 2
 
-    def mesh(k: int, z1: int, r1: float, eps: float) -> np.ndarray:
+    sun_f, ring_f, planet_f = tooth_factors if tooth_factors is not None else (None, None, None)
+
+    def mesh(k: int, z1: int, r1: float, eps: float, pinion=None, wheel=None) -> np.ndarray:
         depths = np.zeros(z1) if error_depths_m[k] is None else error_depths_m[k]
         return pack_mesh_parameters(
+            pinion_factors=pinion,
+            wheel_factors=wheel,
             r1_m=r1,
             r2_m=rbp,
             z1=z1,
@@ -198,6 +245,16 @@ def layout_from_geometry(
         )
 
     ring_offset = 2.0 * math.pi * planet_mesh_phases(g).ring_sun / g.z_ring
+    sun_mesh = mesh(0, g.z_sun, rbs, eps_s, sun_f)
+    ring_mesh = mesh(1, g.z_ring, rbr, eps_r, ring_f)
+    planet_meshes = None
+    if planet_f is not None and any(min(f) < 1.0 for f in planet_f):
+        rows_s, rows_r = [], []
+        for n, f in enumerate(planet_f):
+            f = np.asarray(f, float)
+            rows_s.append(mesh(0, g.z_sun, rbs, eps_s, sun_f, f))
+            rows_r.append(mesh(1, g.z_ring, rbr, eps_r, ring_f, f[ring_wheel_teeth(g, n)]))
+        planet_meshes = (np.array(rows_s), np.array(rows_r))
     return PlanetaryLayout(
         sun=sun,
         ring=ring,
@@ -208,10 +265,22 @@ def layout_from_geometry(
         base_radius_sun_m=rbs,
         base_radius_planet_m=rbp,
         base_radius_ring_m=rbr,
-        sun_mesh=mesh(0, g.z_sun, rbs, eps_s),
-        ring_mesh=mesh(1, g.z_ring, rbr, eps_r),
+        sun_mesh=sun_mesh,
+        ring_mesh=ring_mesh,
         mesh_angle_offsets_rad=tuple((0.0, ring_offset) for _ in g.planet_angles_rad),
+        planet_meshes=planet_meshes,
+        pin_errors_m=tuple(pin_errors_m),
+        bearing_factors=tuple(bearing_factors),
     )
+
+
+def ring_wheel_teeth(geometry, n: int) -> np.ndarray:
+    """Planet tooth (sun-mesh numbering) in the ring mesh's period with wheel index k = 0..z_p - 1, for
+    planet n (0-based): ``(k - M_n - floor(z_p / 2)) mod z_p``, ``M_n = (z_s + z_r) psi_n / 2 pi``
+    (docs/planetary.md, "Faults": a tooth meets the ring (z_p - 1) / 2 mesh periods after the sun)."""
+    g = geometry
+    M = round((g.z_sun + g.z_ring) * g.planet_angles_rad[n] / (2.0 * math.pi))
+    return (np.arange(g.z_planet) - M - g.z_planet // 2) % g.z_planet
 
 
 def _member(name: str, m) -> PlanetaryMember:
@@ -245,6 +314,7 @@ def layout_from_stage(stage, stage_index: int, seed: int, *, modal: bool = False
             planet=_member("planet", stage.planet),
             stiffness_single_N_per_m=k_mean,
             stiffness_double_N_per_m=k_mean,
+            bearing_factors=stage.bearing_factors() if stage.planet_bearing_defects else (),
         )
 
     meshes = (stage.sun_mesh, stage.ring_mesh)
@@ -270,4 +340,19 @@ def layout_from_stage(stage, stage_index: int, seed: int, *, modal: bool = False
         pitch_point_phase=tuple(m.pitch_point_phase for m in meshes),
         error_a=(modes["sun"].a, modes["ring"].a),
         error_depths_m=depths,
+        **_fault_keys(stage),
     )
+
+
+def _fault_keys(stage) -> dict:
+    """layout_from_geometry's fault arguments of a stage (none when it has no faults)."""
+    if not stage.has_faults:
+        return {}
+    planets = [stage.tooth_factors("planet", n + 1) for n in range(stage.planets)]
+    out = {
+        "tooth_factors": (stage.tooth_factors("sun"), stage.tooth_factors("ring"), planets),
+        "bearing_factors": stage.bearing_factors() if stage.planet_bearing_defects else (),
+    }
+    if any(e != 0.0 for e in stage.planet_position_errors_um):
+        out["pin_errors_m"] = tuple(e * 1e-6 for e in stage.planet_position_errors_um)
+    return out

@@ -184,7 +184,7 @@ def _compound_frequencies(scenario: Scenario) -> list[CoordinateFrequency]:
     for link, modal in zip(layout.planetary, compound_layout(scenario, modal=True).planetary, strict=True):
         K_stage = np.diag(stage_stiffness_matrix(modal))
         ref, G = link.reference(), link.geometry_rows()
-        Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
+        Ps, Pr = link.layout.mesh_arrays()
         members = (*link.layout.members, *([link.layout.planet] * (len(link.names) - 3)))
         for j in range(link.size):
             i, h = link.first + j, 1e-6

@@ -36,7 +36,7 @@ def planetary_stage_user_function(link: PlanetaryLink):
     """The force function of one planetary stage's item: coordinates are displacements from the nominal
     assembly, the compiled law takes absolute ones."""
     ref, G = link.reference(), link.geometry_rows()
-    Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
+    Ps, Pr = link.layout.mesh_arrays()
     forces = compiled(stage_forces, ref, ref, G, Ps, Pr)
 
     def stage_items(mbs, t, itemNumber, q, q_t):

@@ -52,7 +52,8 @@ def planetary_signals(scenario: Scenario, names: list[str], q, v, a) -> dict[str
         states = _stage_states(link, names, q, v)
         for n in range(st.planets):
             planet = f"{prefix}planet_{n + 1}"
-            for mesh, P, col in (("sun", link.layout.sun_mesh, 0), ("ring", link.layout.ring_mesh, 3)):
+            laws = (("sun", link.layout.sun_mesh_of(n), 0), ("ring", link.layout.ring_mesh_of(n), 3))
+            for mesh, P, col in laws:
                 angle = np.ascontiguousarray(states[:, n, col])
                 delta = np.ascontiguousarray(states[:, n, col + 1])
                 F, _ = mesh_contact_series(angle, delta, np.ascontiguousarray(states[:, n, col + 2]), P)
@@ -96,8 +97,8 @@ def _ring_sensor(link: PlanetaryLink, st: PlanetaryStage, names, q, signals, pre
 
 def _planet_bearing(link: PlanetaryLink, names, q, n: int, planet: str) -> dict[str, np.ndarray]:
     """Planet n's centre (absolute, fixed frame) and its bearing deflection (centre minus its carrier
-    point), radial and tangential in the carrier frame, m."""
-    rc, psi = link.layout.carrier_radius_m, link.layout.planet_angles_rad[n]
+    point, the pin), radial and tangential in the carrier frame, m."""
+    rc, psi = link.layout.carrier_radius_m, link.layout.pin_angle_rad(n)
     ic = names.index(link.names[2] + "_x")
     ip = names.index(planet + "_x")
     theta = q[ic + 2] + psi
@@ -119,6 +120,6 @@ def planetary_jump_times(scenario: Scenario, k: int, names, t_s: np.ndarray, q, 
     states = _stage_states(link, names, q, v)
     out = []
     for n in range(len(link.layout.planet_angles_rad)):
-        for P, col in ((link.layout.sun_mesh, 0), (link.layout.ring_mesh, 3)):
+        for P, col in ((link.layout.sun_mesh_of(n), 0), (link.layout.ring_mesh_of(n), 3)):
             out.append(mesh_jump_times(t_s, states[:, n, col], states[:, n, col + 1], P))
     return out

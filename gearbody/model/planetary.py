@@ -176,7 +176,9 @@ class PlanetaryStage(Node):
             key = f"damaged_teeth.{i}"
             if t.member == "planet":
                 if t.planet is None:
-                    raise ScenarioError(f"{key}.planet: required for member 'planet'; allowed: 1..{self.planets}")
+                    raise ScenarioError(
+                        f"{key}.planet: required for member 'planet'; allowed: 1..{self.planets}"
+                    )
                 if t.planet > self.planets:
                     raise ScenarioError(f"{key}.planet = {t.planet}: allowed: 1..{self.planets}")
             elif t.planet is not None:
@@ -192,7 +194,8 @@ class PlanetaryStage(Node):
             ident = (t.member, t.planet, t.tooth)
             if ident in seen:
                 raise ScenarioError(
-                    f"{key}: one entry per damaged tooth: {t.member} tooth {t.tooth} is also entry {seen[ident]}"
+                    f"{key}: one entry per damaged tooth: {t.member} tooth {t.tooth} is also entry "
+                    f"{seen[ident]}"
                 )
             seen[ident] = i
         errors = self.planet_position_errors_um

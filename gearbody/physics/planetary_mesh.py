@@ -33,7 +33,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from .mesh import mesh_contact
 
@@ -189,12 +190,28 @@ def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarr
     return f, F_sun, F_ring
 
 
+def _law_rows(P: np.ndarray) -> np.ndarray:
+    """A packed law as rows: one shared law (1-D) as a (1, len) view, per-planet laws (N, len) as they are."""
+    return P.reshape((1, P.size)) if P.ndim == 1 else P
+
+
+@overload(_law_rows)
+def _law_rows_compiled(P):
+    if isinstance(P, types.Array) and P.ndim == 1:
+        return lambda P: P.reshape((1, P.size))
+    return lambda P: P
+
+
 @njit(cache=True)
 def stage_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarray, P_ring: np.ndarray):
     """Generalised forces of every planet's meshes and bearing: ``q``, ``q_t`` absolute [x, y, theta] of
-    sun, ring, carrier, then planet 1..N (9 + 3 N); ``G`` one geometry row per planet (N x G_SIZE). One
-    call for the whole stage (the solver's per-call overhead, not the law, dominates one call per planet)."""
+    sun, ring, carrier, then planet 1..N (9 + 3 N); ``G`` one geometry row per planet (N x G_SIZE);
+    ``P_sun``, ``P_ring`` one packed law shared by every planet (1-D) or one row per planet (N x len,
+    a planet's own damaged teeth, docs/planetary.md "Faults"). One call for the whole stage (the
+    solver's per-call overhead, not the law, dominates one call per planet)."""
     n = G.shape[0]
+    Ps, Pr = _law_rows(P_sun), _law_rows(P_ring)
+    ns, nr = Ps.shape[0], Pr.shape[0]
     f = np.zeros(9 + 3 * n)
     qk = np.empty(12)
     qtk = np.empty(12)
@@ -204,7 +221,7 @@ def stage_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarra
         o = 9 + 3 * k
         for i in range(3):
             qk[9 + i], qtk[9 + i] = q[o + i], q_t[o + i]
-        fk = planet_forces(qk, qtk, G[k], P_sun, P_ring)[0]
+        fk = planet_forces(qk, qtk, G[k], Ps[k % ns], Pr[k % nr])[0]
         for i in range(9):
             f[i] += fk[i]
         for i in range(3):
