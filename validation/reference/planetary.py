@@ -52,7 +52,7 @@ class _PlanetaryBlock:
         st = self.st
         kind = ("sun", "ring")[j % 2]
         geo = st.mesh_geometry(q, v)[kind]
-        law = st.laws[kind]
+        law = st.planet_laws[j // 2][kind]
         p = geo[4][j // 2] * law.cz - n
         return geo[0][j // 2] + _mode_error(law.mode_consts(n, k, 0), p), geo[1][j // 2]
 
@@ -62,7 +62,7 @@ class _PlanetaryBlock:
         events, actions = [], []
         for j, (n, k, c) in enumerate(modes):
             planet, kind = j // 2, ("sun", "ring")[j % 2]
-            law = st.laws[kind]
+            law = st.planet_laws[planet][kind]
             lo, hi = n + float(law.bA[k]) - _ETA_U, n + float(law.bB[k]) + _ETA_U
 
             def ev_up(t, y, a=(planet, kind, law.cz, hi)):

@@ -125,6 +125,26 @@ class PlanetaryStage:
         self.inertia = np.array([float(x["inertia_kg_m2"]) for x in members])
         self.kb = [float(x["bearing_stiffness_N_per_m"]) for x in (sun, ring, car, pl)]
         self.cb = [float(x.get("bearing_damping_Ns_per_m", 0.0)) for x in (sun, ring, car, pl)]
+        # faults (contract "Faults"): planet bearing factors, pin errors, damaged teeth
+        self.bearing_factor = np.ones(N)
+        for d in stage.get("planet_bearing_defects", []):
+            n = int(d["planet"])
+            if not 1 <= n <= N or not 0.0 < float(d["stiffness_factor"]) <= 1.0:
+                raise ValueError(
+                    f"stage {stage_index + 1}: planet bearing defect {d}: planet 1..N, factor (0, 1]"
+                )
+            self.bearing_factor[n - 1] = float(d["stiffness_factor"])
+        pins = [float(e) * 1e-6 for e in stage.get("planet_position_errors_um", [])]
+        if pins and len(pins) != N:
+            raise ValueError(f"stage {stage_index + 1}: planet_position_errors_um needs N values")
+        self.pin_angle = self.psi + (np.array(pins) / self.r_c if pins else 0.0)
+        factors = {"sun": np.ones(zs), "ring": np.ones(zr), "planet": np.ones((N, zp))}
+        for t in stage.get("damaged_teeth", []):
+            member, tooth, f = t["member"], int(t["tooth"]), float(t["stiffness_factor"])
+            row = factors[member] if member != "planet" else factors["planet"][int(t["planet"]) - 1]
+            if not 0 <= tooth < row.size or not 0.0 <= f <= 1.0:
+                raise ValueError(f"stage {stage_index + 1}: damaged tooth {t}: tooth or factor out of range")
+            row[tooth] *= f
         for name, x in (("sun", sun), ("ring", ring), ("carrier", car)):
             if name != self.fixed and "torsion_stiffness_Nm_per_rad" in x:
                 raise ValueError(f"stage {stage_index + 1}: torsion_stiffness on {name}, which is not fixed")
@@ -137,8 +157,20 @@ class PlanetaryStage:
         # meshes: the reference's own law on a mesh view each; z1 = sun (sun mesh) or ring (ring mesh)
         self.F_rated = float(F_rated) if F_rated is not None else 1.0
         self.g_ring = 0.0 if zp % 2 else 0.5
-        self.laws = {}
-        for kind, z1, r1, i1, key in (("sun", zs, self.r_bs, sun, 1), ("ring", zr, self.r_br, ring, 2)):
+        # Planet n's tooth j meets the ring in the ring mesh's periods n_r = j + M_n + floor(z_p / 2)
+        # (mod z_p), M_n = (z_s + z_r) psi_n / 2 pi: the ring view's wheel tooth k is planet tooth
+        # k - M_n - floor(z_p / 2).
+        M = np.rint((zs + zr) * self.psi / (2.0 * math.pi)).astype(int)
+
+        def damaged(pinion: np.ndarray, wheel: np.ndarray) -> list:
+            return [
+                {"gear": gear, "tooth": i, "stiffness_factor": float(f)}
+                for gear, arr in (("pinion", pinion), ("wheel", wheel))
+                for i, f in enumerate(arr)
+                if f != 1.0
+            ]
+
+        def law_of(kind, z1, r1, i1, key, wheel_factors):
             mesh = dict(stage[f"{kind}_mesh"])
             mesh.setdefault("contact_ratio", self.contact_ratio[kind])
             em = stage.get(f"{kind}_error_mode", {"a": 0.5, "e_um": 0.0, "r": 0.0})
@@ -155,18 +187,37 @@ class PlanetaryStage:
                 self.F_rated,
                 seed,
             )
+            view["condition"]["damaged_teeth"] = damaged(factors[kind], wheel_factors)
             law = _Mesh(view, self.F_rated)
             l_rand = np.random.default_rng([seed, stage_index, key]).random(z1)
             law.e_amp = (1.0 - float(em["r"]) * (1.0 - l_rand)) * float(em["e_um"]) * 1e-6
-            self.laws[kind] = law
+            return law
+
+        self.planet_laws = []
+        healthy = None  # healthy planets share one pair of laws
+        for n in range(N):
+            fp = factors["planet"][n]
+            if np.all(fp == 1.0) and healthy is not None:
+                self.planet_laws.append(healthy)
+                continue
+            ring_wheel = np.array([fp[(k - M[n] - zp // 2) % zp] for k in range(zp)])
+            laws = {
+                "sun": law_of("sun", zs, self.r_bs, sun, 1, fp),
+                "ring": law_of("ring", zr, self.r_br, ring, 2, ring_wheel),
+            }
+            if np.all(fp == 1.0):
+                healthy = laws
+            self.planet_laws.append(laws)
+        self.laws = self.planet_laws[0]
         # the 2N meshes: planet n's sun mesh is mesh 2n, its ring mesh 2n + 1
-        self.meshes = [self.laws[k] for _n in range(N) for k in ("sun", "ring")]
+        self.meshes = [self.planet_laws[n][k] for n in range(N) for k in ("sun", "ring")]
         q0 = np.zeros(self.n_dof)
         q0[9::3], q0[10::3] = self.r_c * np.cos(self.psi), self.r_c * np.sin(self.psi)
-        self.q_nominal = q0
         self.delta0 = {"sun": np.zeros(N), "ring": np.zeros(N)}
-        g = self.mesh_geometry(q0, np.zeros(self.n_dof))
+        g = self.mesh_geometry(q0, np.zeros(self.n_dof))  # of the error-free assembly: pin errors preload
         self.delta0 = {"sun": g["sun"][0], "ring": g["ring"][0]}
+        q0[9::3], q0[10::3] = self.r_c * np.cos(self.pin_angle), self.r_c * np.sin(self.pin_angle)
+        self.q_nominal = q0
 
     # -- kinematics -------------------------------------------------------------------------------------
     def rigid_speeds(self, member: str, w_member: float, w_other: tuple[str, float] | None = None):
@@ -246,7 +297,7 @@ class PlanetaryStage:
         F = {}
         for j, kind in enumerate(("sun", "ring")):
             delta, ddot, _, _, ang, _ = geo[kind]
-            cz = self.laws[kind].cz
+            cz = self.laws[kind].cz  # z1 / 2 pi, the same for every planet
             F[kind] = [
                 _mesh_force(mcs[2 * n + j], ang[n] * cz - modes[2 * n + j][0], delta[n], ddot[n])
                 for n in range(self.N)
@@ -264,10 +315,10 @@ class PlanetaryStage:
         Q[f] -= self.kt * q[f] + cf * self.ct * v[f]
         xc, yc, tc = q[6], q[7], q[8]
         vxc, vyc, wc = v[6], v[7], v[8]
-        kp, cp = self.kb[3], cf * self.cb[3]
         for n in range(self.N):
+            kp, cp = self.kb[3] * self.bearing_factor[n], cf * self.cb[3] * self.bearing_factor[n]
             b = 9 + 3 * n
-            a = tc + self.psi[n]
+            a = tc + self.pin_angle[n]
             ax, ay = self.r_c * math.cos(a), self.r_c * math.sin(a)  # P_n - c_c
             fx = -kp * (q[b] - xc - ax) - cp * (v[b] - vxc + wc * ay)  # bearing force on the planet
             fy = -kp * (q[b + 1] - yc - ay) - cp * (v[b + 1] - vyc - wc * ax)
@@ -297,7 +348,7 @@ class PlanetaryStage:
         modes = []
         for n in range(self.N):
             for kind in ("sun", "ring"):
-                law = self.laws[kind]
+                law = self.planet_laws[n][kind]
                 delta, ddot, _, _, ang, angdot = geo[kind]
                 nn, k = law.phase_mode(float(ang[n] * law.cz), float(angdot[n] * law.cz))
                 mc = law.mode_consts(nn, k, 0)
