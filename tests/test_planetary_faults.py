@@ -140,7 +140,6 @@ def test_a_planet_tooth_meets_the_ring_half_a_turn_less_half_a_pitch_after_the_s
             assert sum(tooth_pair_factor(0, i, rows[n]) for i in range(Z_P)) == Z_P - 0.5
 
 
-@pytest.mark.slow
 def test_a_faulted_drive_agrees_with_the_reference():
     """Sun, ring and planet teeth, pin errors and a weak planet bearing at once, 0.04 s steady at the rated
     load (the damaged planet tooth meets the sun at ~3 ms and the ring at ~35 ms): every planet mesh
