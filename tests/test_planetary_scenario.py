@@ -251,3 +251,24 @@ def test_the_drive_modes_equal_eigh_of_the_lin_parker_matrices_with_the_shafts()
     assert f_gearbody.size == f_hand.size == n
     np.testing.assert_allclose(f_gearbody[1:], np.sort(f_hand)[1:], rtol=1e-6)
     assert f_gearbody[0] < 1e-6 * f_gearbody[-1]  # the free drive's rigid rotation
+
+
+def test_iso_6336_method_b_for_the_planetary_meshes_by_hand():
+    """stiffness_profile = 'iso-6336-b' on the conveyor's planetary stage (z 29/37/103, m 8 mm, 20 deg,
+    b = 100 mm, 6.5 kN per planet mesh): q' = C1 + C2/z_n1 + C3/z_n2 by hand (sun mesh: z_n 29, 37; ring
+    mesh: the planet's 37 and a rack's inf), c' = c_th 0.8 C_B (C_B = 0.975 for h_fP = 1.25 m) times the
+    line-load factor (F_t / b / 100)^0.25, k_single = c' b, k_double = 1.75 k_single."""
+    sc = load_scenario("planetary-conveyor")
+    st = sc.stages[1]
+    F_t = sc.stage_rated_force_N(1) * math.cos(math.radians(20.0)) / 100.0  # N/mm
+    for mesh, q in (
+        (st.sun_mesh, 0.04723 + 0.15551 / 29 + 0.25791 / 37),
+        (st.ring_mesh, 0.04723 + 0.15551 / 37),
+    ):
+        c_prime = (1 / q) * 0.8 * 0.975 * (F_t / 100.0) ** 0.25
+        assert mesh.stiffness_single_N_per_m == pytest.approx(c_prime * 100 * 1e6, rel=1e-12)
+        assert mesh.stiffness_double_N_per_m == pytest.approx(1.75 * c_prime * 100 * 1e6, rel=1e-12)
+    d = read_toml(scene_path("planetary-conveyor"))
+    del d["design"]["stages"][1]["sun_mesh"]["face_width_mm"]
+    with pytest.raises(ScenarioError, match="face_width_mm: required with stiffness_profile = 'iso-6336-b'"):
+        load_scenario(d)
