@@ -228,12 +228,39 @@ class Result:
         stats = self.meta.get("solver_statistics", {})
         t = float(self.time_s[-1] - self.time_s[0])
         out: dict[str, Any] = {"scene": self.meta.get("scene")}
+        # the first stage's K_d over all its meshes (every planet's sun and ring mesh): the keys studies
+        # and calibrations read by default
+        first = self.meta["stages"][0]
+        names = (
+            [f"planet_{p + 1}_{m}_mesh" for p in range(first["planets"]) for m in ("sun", "ring")]
+            if first.get("type") == "planetary"
+            else ["mesh"]
+        )
+        kd = np.array([self[n + "_kd" if n != "mesh" else "kd"] for n in names])
+        seps = [
+            separation_stats(self[n + "_force_N"], self.time_s, kd=self[n + "_kd" if n != "mesh" else "kd"])
+            for n in names
+        ]
+        out.update(
+            {
+                "kd_max": float(kd.max()),
+                "kd_min": float(kd.min()),
+                "kd_max_final": float(kd[:, win].max()),
+                "kd_mean_final": float(kd[:, win].mean()),
+                "kd_above_2": bool(kd.max() > 2.0),
+                "separation_fraction": float(max(s.separated_fraction for s in seps)),
+                "contact_losses": int(sum(s.contact_losses for s in seps)),
+                "mesh_frequency_hz": float(np.mean(self["mesh_frequency_hz"][win])),
+            }
+        )
         for k, meta in enumerate(self.meta["stages"]):
             prefix = "" if k == 0 else f"stage_{k + 1}_"
             if meta.get("type") != "planetary":
-                kd = self[prefix + "kd"]
-                out[f"{prefix}kd_max"], out[f"{prefix}kd_min"] = float(np.max(kd)), float(np.min(kd))
-                out[f"{prefix}kd_mean_final"] = float(np.mean(kd[win]))
+                if k > 0:
+                    kd = self[prefix + "kd"]
+                    out[f"{prefix}kd_max"], out[f"{prefix}kd_min"] = float(np.max(kd)), float(np.min(kd))
+                    out[f"{prefix}kd_max_final"] = float(np.max(kd[win]))
+                    out[f"{prefix}kd_mean_final"] = float(np.mean(kd[win]))
                 continue
             for mesh in ("sun", "ring"):
                 names = [f"{prefix}planet_{p + 1}_{mesh}_mesh" for p in range(meta["planets"])]
@@ -243,6 +270,7 @@ class Result:
                     separation_stats(self[n + "_force_N"], self.time_s, kd=self[n + "_kd"]) for n in names
                 ]
                 out[f"{prefix}{mesh}_mesh_kd_max"] = float(kd.max())
+                out[f"{prefix}{mesh}_mesh_kd_max_final"] = float(kd[:, win].max())
                 out[f"{prefix}{mesh}_mesh_kd_min"] = float(kd.min())
                 out[f"{prefix}{mesh}_mesh_kd_mean_final"] = float(means.mean())
                 out[f"{prefix}{mesh}_mesh_load_sharing_factor"] = float(means.max() / means.mean())
@@ -250,7 +278,8 @@ class Result:
                     max(s.separated_fraction for s in seps)
                 )
                 out[f"{prefix}{mesh}_mesh_contact_losses"] = int(sum(s.contact_losses for s in seps))
-            out[f"{prefix}mesh_frequency_hz"] = float(np.mean(self[prefix + "mesh_frequency_hz"][win]))
+            if k > 0:
+                out[f"{prefix}mesh_frequency_hz"] = float(np.mean(self[prefix + "mesh_frequency_hz"][win]))
             out[f"{prefix}rated_mesh_force_N"] = float(meta["rated_mesh_force_N"])
         out.update(
             {

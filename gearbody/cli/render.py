@@ -92,7 +92,8 @@ def register(sub) -> argparse.ArgumentParser:
         choices=("drive", "gears", "mesh"),
         default="drive",
         help="what the camera fits: the whole drive (default), the gears, or the first stage's mesh (its "
-        "pitch point +- 6 modules: the teeth in contact); gears and mesh hide motor and machine",
+        "pitch point +- 6 modules: the teeth in contact; planetary: sun-planet 1, followed as it revolves); "
+        "gears and mesh hide motor and machine",
     )
     rd.add_argument(
         "--housing",

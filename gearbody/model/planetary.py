@@ -37,8 +37,19 @@ class PlanetaryMesh(Node):
     """The law of every sun-planet (or ring-planet) mesh: the parallel mesh law's rectangular stiffness
     profile, damping, backlash and transition width."""
 
-    stiffness_single_N_per_m: float = param(gt=0, doc="k_z with one tooth pair in contact")
-    stiffness_double_N_per_m: float = param(gt=0, doc="k_z with two tooth pairs in contact")
+    stiffness_profile: str = param(
+        "contact-ratio",
+        choices=("contact-ratio", "iso-6336-b"),
+        doc="k_z from the two stiffness values, or from ISO 6336-1 method B (face_width_mm; internal mesh "
+        "approximated, docs/planetary.md)",
+    )
+    stiffness_single_N_per_m: float | None = param(
+        None, gt=0, doc="k_z with one tooth pair in contact (contact-ratio; iso-6336-b: computed)"
+    )
+    stiffness_double_N_per_m: float | None = param(
+        None, gt=0, doc="k_z with two tooth pairs in contact (contact-ratio; iso-6336-b: computed)"
+    )
+    face_width_mm: float | None = param(None, gt=0, le=2000, doc="face width b (iso-6336-b)")
     contact_ratio: float | None = param(
         None, ge=1, lt=2, doc="transverse contact ratio (unset: of the standard teeth)"
     )
@@ -48,6 +59,17 @@ class PlanetaryMesh(Node):
     transition_width: float = param(
         0.0, ge=0, le=0.2, doc="fraction of the mesh period over which the tooth change is smoothed"
     )
+
+    def __post_init__(self) -> None:
+        given = (self.stiffness_single_N_per_m, self.stiffness_double_N_per_m)
+        if self.stiffness_profile == "contact-ratio":
+            if None in given:
+                raise ScenarioError(
+                    "stiffness_single_N_per_m and stiffness_double_N_per_m: required with stiffness_profile "
+                    "= 'contact-ratio' (> 0 N/m), or set stiffness_profile = 'iso-6336-b' and face_width_mm"
+                )
+        elif self.face_width_mm is None:
+            raise ScenarioError("face_width_mm: required with stiffness_profile = 'iso-6336-b' (> 0 mm)")
 
 
 @dataclass(frozen=True, kw_only=True)

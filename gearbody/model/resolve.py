@@ -186,6 +186,37 @@ def resolve_iso_stiffness(mesh, teeth_pinion: int, teeth_wheel: int, rated_force
     )
 
 
+def resolve_planetary_iso(stage, rated_force_N: float, k: int):
+    """A planetary stage with each iso-6336-b mesh's single/double stiffness computed at the rated force
+    per planet mesh (line load F_rated cos(alpha) / b); a given value must agree (as for parallel meshes)."""
+    from ..physics.stiffness_iso import planetary_mesh_stiffness_profile
+
+    changes = {}
+    for name, teeth_2 in (("sun_mesh", stage.sun.teeth), ("ring_mesh", None)):
+        mesh = getattr(stage, name)
+        if mesh.stiffness_profile != "iso-6336-b":
+            continue
+        alpha = math.radians(stage.pressure_angle_deg)
+        single, double = planetary_mesh_stiffness_profile(
+            teeth_1=stage.planet.teeth,
+            teeth_2=teeth_2,
+            face_width_m=mesh.face_width_mm * 1e-3,
+            pressure_angle_deg=stage.pressure_angle_deg,
+            line_load_N_per_mm=rated_force_N * math.cos(alpha) / mesh.face_width_mm,
+        )
+        where = stage_key(k, name + ".")
+        changes[name] = dataclasses.replace(
+            mesh,
+            stiffness_single_N_per_m=_agree(
+                where, "stiffness_single_N_per_m", mesh.stiffness_single_N_per_m, single
+            ),
+            stiffness_double_N_per_m=_agree(
+                where, "stiffness_double_N_per_m", mesh.stiffness_double_N_per_m, double
+            ),
+        )
+    return dataclasses.replace(stage, **changes) if changes else stage
+
+
 def resolve_design(design):
     """The design with every stage's [geometry] resolved: gears and mesh (base radii, contact ratio,
     pitch point, backlash, stiffness), then the ISO stiffness at each stage's rated force, and the
@@ -200,6 +231,7 @@ def resolve_design(design):
     design = dataclasses.replace(design, stages=tuple(stages))
     for k, st in enumerate(design.stages):
         if not hasattr(st, "pinion"):
+            stages[k] = resolve_planetary_iso(st, design.stage_rated_force_N(k), k)
             continue
         where = stage_key(k, "mesh.")
         if st.mesh.stiffness_profile == "iso-6336-b":

@@ -211,3 +211,33 @@ def iso_mesh_stiffness_profile(geometry: GearPairGeometry, **iso_options) -> tup
     if geometry.total_contact_ratio >= 2.0:
         return iso.mesh_alpha_N_per_m, iso.mesh_alpha_N_per_m
     return iso.single_N_per_m, DOUBLE_TO_SINGLE_RATIO * iso.single_N_per_m
+
+
+def planetary_mesh_stiffness_profile(
+    *,
+    teeth_1: int,
+    teeth_2: int | None,
+    face_width_m: float,
+    pressure_angle_deg: float,
+    dedendum_coefficient: float = 1.25,
+    line_load_N_per_mm: float | None = None,
+) -> tuple[float, float]:
+    """(k_single, k_double) in N/m of a planetary stage's standard spur mesh by method B: the sun-planet
+    mesh with ``teeth_1``, ``teeth_2`` (the smaller is ISO's pinion), the ring-planet mesh with the planet's
+    ``teeth_1`` and ``teeth_2 = None`` (internal). ISO 6336-1's flexibility q' is a fit to external gears;
+    for the internal mesh this takes the internal gear's term as a rack's (z_n2 = inf): an approximation
+    (the internal tooth, thicker at its root, is somewhat stiffer than a rack tooth, so the ring mesh comes
+    out a little soft). Solid blanks (C_R = 1), C_M = 0.8, the basic-rack factor of ``dedendum_coefficient``
+    and the pressure angle, the line-load factor below 100 N/mm; k_double = 1.75 k_single as for parallel
+    stages (module docstring)."""
+    if teeth_2 is None:
+        zn1, zn2 = float(teeth_1), math.inf
+    else:
+        zn1, zn2 = float(min(teeth_1, teeth_2)), float(max(teeth_1, teeth_2))
+    c_th = theoretical_single_stiffness_N_per_mm_um(virtual_teeth_pinion=zn1, virtual_teeth_wheel=zn2)
+    c_b = basic_rack_factor(
+        dedendum_coefficient_pinion=dedendum_coefficient, rack_pressure_angle_deg=pressure_angle_deg
+    )
+    c_prime = c_th * THEORETICAL_CORRECTION_C_M * c_b * line_load_factor(line_load_N_per_mm)
+    single = stiffness_N_per_m(c_prime, face_width_m)
+    return single, DOUBLE_TO_SINGLE_RATIO * single

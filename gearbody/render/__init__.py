@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import Scenario
+from ..model.planetary import PlanetaryStage
 from ..result import Result
 from .layout import Layout, build_layout
 from .movie import FORMATS, ffmpeg_available, write_gif, write_mp4, write_png
@@ -54,8 +55,8 @@ def check_result_matches(scenario: Scenario, result: Result) -> None:
         return
     design = saved.get("design", {})
     stages = design.get("stages") or [{"pinion": design.get("pinion", {}), "wheel": design.get("wheel", {})}]
-    ours = [(st.pinion.teeth, st.wheel.teeth) for st in scenario.stages]
-    theirs = [(st.get("pinion", {}).get("teeth"), st.get("wheel", {}).get("teeth")) for st in stages]
+    ours = [_teeth(st) for st in scenario.stages]
+    theirs = [_teeth(st) for st in stages]
     if theirs != ours:
         raise RenderError(
             f"result: simulated for teeth {theirs}, but the scene has {ours}; render the result with its "
@@ -63,12 +64,26 @@ def check_result_matches(scenario: Scenario, result: Result) -> None:
         )
 
 
-def _motion(scenario: Scenario, result: Result | None, until_s: float = 0.0) -> Result:
+def _teeth(stage) -> tuple:
+    """A stage's teeth, of a Stage or PlanetaryStage or their saved dict: (pinion, wheel), or
+    ('planetary', sun, planet, ring, planets)."""
+    if isinstance(stage, dict):
+        if stage.get("type") == "planetary":
+            z = [stage.get(m, {}).get("teeth") for m in ("sun", "planet", "ring")]
+            return ("planetary", *z, stage.get("planets"))
+        return (stage.get("pinion", {}).get("teeth"), stage.get("wheel", {}).get("teeth"))
+    if isinstance(stage, PlanetaryStage):
+        return ("planetary", stage.sun.teeth, stage.planet.teeth, stage.ring.teeth, stage.planets)
+    return (stage.pinion.teeth, stage.wheel.teeth)
+
+
+def _motion(scenario: Scenario, result: Result | None, layout: Layout, until_s: float = 0.0) -> Result:
     """The result to draw: the given one (checked against the drive), or rigid rotation at the
     synchronous speed for one input revolution (at least until ``until_s``)."""
     if result is None:
         speed = scenario.design.motor.synchronous_speed_rad_s
-        return kinematic_result(speed, max(2 * np.pi / speed, until_s))
+        duration = max(2 * np.pi / speed, until_s)
+        return kinematic_result(layout.input_factor * speed, duration, signal=layout.input_signal)
     check_result_matches(scenario, result)
     return result
 
@@ -78,8 +93,12 @@ def _images(layout: Layout, result: Result, times_s, options, lateral_scale, lat
 
     poses = body_poses(layout, result, np.asarray(times_s, dtype=float), lateral_scale, lateral_about_mean)
     system = VisualSystem(layout, options)
+    # the sun-planet 1 mesh revolves with the carrier: the mesh camera follows it
+    follow = system.options.frame == "mesh" and layout.mesh_pair is not None
     system.set_camera()
     for t, row in zip(times_s, poses, strict=True):
+        if follow:
+            system.set_camera(row)
         system.set_pose(row, t)
         yield float(t), system.image()
 
@@ -94,8 +113,9 @@ def render_images(
 ):
     """Yield (time, RGB image) for each time: the drive in the result's pose, raytraced (no result:
     rigid rotation at the synchronous speed)."""
-    result = _motion(scenario, result, float(np.max(times_s)))
-    yield from _images(build_layout(scenario), result, times_s, options, lateral_scale, lateral_about_mean)
+    layout = build_layout(scenario)
+    result = _motion(scenario, result, layout, float(np.max(times_s)))
+    yield from _images(layout, result, times_s, options, lateral_scale, lateral_about_mean)
 
 
 def render(
@@ -133,8 +153,8 @@ def render(
     options.check()
     check_frames(frames, options.width_px, options.height_px, movie)
     layout = build_layout(scenario)
-    result = _motion(scenario, result)
-    times = frame_times(result, frames, start_s, end_s)
+    result = _motion(scenario, result, layout)
+    times = frame_times(result, frames, start_s, end_s, layout.input_signal)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     for old in [*out.glob("frame_*.png"), out / "animation.gif", out / "animation.mp4"]:
@@ -183,7 +203,7 @@ def view(
     if not has_display():
         raise RenderError("no display: the interactive viewer needs one; use render() for pictures")
     layout = build_layout(scenario)
-    result = _motion(scenario, result)
-    times = frame_times(result, frames, start_s, end_s)
+    result = _motion(scenario, result, layout)
+    times = frame_times(result, frames, start_s, end_s, layout.input_signal)
     poses = body_poses(layout, result, times, lateral_scale, lateral_about_mean)
     VisualSystem(layout, options).view_interactive(times, poses, 1.0 / fps)

@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass, field
 
 from ..model import Scenario
+from ..model.planetary import PlanetaryStage
 from ..physics.lateral import mesh_directions
 
 # Colours (RGBA).
@@ -78,6 +79,11 @@ class GearShape:
     colour: tuple[float, float, float, float]
     # (body-frame angle of the tooth centre, colour) for damaged and pitted teeth
     marked_teeth: tuple[tuple[float, tuple[float, float, float, float]], ...] = ()
+    # a planetary stage's gears: outline "gearbody" (render.planetary.tooth_outline; Exudyn's fails for
+    # some teeth counts); an internal gear (the ring) has its teeth inside a rim of radius rim_radius_m
+    internal: bool = False
+    rim_radius_m: float = 0.0
+    outline: str = "exudyn"
 
     @property
     def pitch_radius_m(self) -> float:
@@ -85,11 +91,39 @@ class GearShape:
 
     @property
     def tip_radius_m(self) -> float:
-        return self.pitch_radius_m + self.module_m
+        return self.pitch_radius_m + (-1 if self.internal else 1) * self.module_m
 
     @property
     def root_radius_m(self) -> float:
-        return self.pitch_radius_m - 1.25 * self.module_m
+        return self.pitch_radius_m + (1 if self.internal else -1) * 1.25 * self.module_m
+
+    @property
+    def outer_radius_m(self) -> float:
+        """Radius of the drawn solid: the tip circle, or an internal gear's rim."""
+        return self.rim_radius_m if self.internal else self.tip_radius_m
+
+
+@dataclass(frozen=True)
+class Prism:
+    """A plate along z from z0_m to z1_m with a polygon outline (body frame), an optional round hole."""
+
+    outline_m: tuple[tuple[float, float], ...]
+    z0_m: float
+    z1_m: float
+    colour: tuple[float, float, float, float]
+    hole_radius_m: float = 0.0
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """A planet's path: round the carrier's axis ``centre_xy_m`` at ``radius_m``, angle ``angle_rad``
+    from the carrier's x axis (drawn); ``centre_signals`` its absolute centre in the stage frame."""
+
+    carrier: str
+    centre_xy_m: tuple[float, float]
+    radius_m: float
+    angle_rad: float
+    centre_signals: tuple[str, str]
 
 
 @dataclass(frozen=True)
@@ -111,6 +145,9 @@ class Body:
     # body `follows` (rigid gear ratio; used by the Muller and two-wheel scenes)
     follows: str | None = None
     ratio: float = 1.0
+    # planetary members: -1 draws the stage mirrored (y offsets negated, see render.planetary)
+    mirror: int = 1
+    orbit: Orbit | None = None  # a planet: rides on the carrier
 
 
 @dataclass
@@ -121,6 +158,9 @@ class Layout:
     housing: Box | None = None
     show_housing: bool = False
     lateral_scale: float = 1000.0
+    input_signal: str = "pinion_angle_rad"  # the input shaft's rotation (frame window, kinematic motion)
+    input_factor: int = 1  # that signal per unit input-shaft rotation in its driven direction
+    mesh_pair: tuple[str, str] | None = None  # bodies of the first mesh (None: the first two gears)
 
     def body(self, name: str) -> Body:
         for b in self.bodies:
@@ -133,12 +173,22 @@ class Layout:
         return [(b, p) for b in self.bodies for p in b.parts if isinstance(p, GearShape)]
 
     def mesh_bounds_m(
-        self, modules: float = MESH_WINDOW_MODULES
+        self, modules: float = MESH_WINDOW_MODULES, pose=None
     ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
         """Box around the first stage's mesh: ``modules`` modules each side of the pitch point in the
-        gears' plane (the teeth in contact and their neighbours), the face width along the axes."""
-        (pinion, gp), (wheel, gw) = self.gears[:2]
+        gears' plane (the teeth in contact and their neighbours), the face width along the axes. For a
+        planetary first stage the sun-planet 1 mesh, where the pose row ``pose`` puts it (default: the
+        nominal assembly)."""
+        if self.mesh_pair is None:
+            (pinion, gp), (wheel, gw) = self.gears[:2]
+        else:
+            gears = dict((b.name, (b, p)) for b, p in self.gears)
+            (pinion, gp), (wheel, gw) = (gears[n] for n in self.mesh_pair)
         (px, py), (wx, wy) = pinion.axis_xy_m, wheel.axis_xy_m
+        if pose is not None and self.mesh_pair is not None:
+            names = [b.name for b in self.bodies]
+            i, j = (3 * names.index(n) for n in self.mesh_pair)
+            px, py, wx, wy = px + pose[i], py + pose[i + 1], wx + pose[j], wy + pose[j + 1]
         share = gp.teeth / (gp.teeth + gw.teeth)  # the operating pitch point divides the centre distance
         cx, cy = px + share * (wx - px), py + share * (wy - py)
         h = modules * max(gp.module_m, gw.module_m)
@@ -160,12 +210,15 @@ class Layout:
             bx, by = b.axis_xy_m
             for p in b.parts:
                 if isinstance(p, GearShape):
-                    r = p.tip_radius_m
+                    r = p.outer_radius_m
                     grow(
                         bx - r, bx + r, by - r, by + r, p.z_m - p.face_width_m / 2, p.z_m + p.face_width_m / 2
                     )
                 elif isinstance(p, Cylinder) and not gears_only:
                     r = p.radius_m
+                    grow(bx - r, bx + r, by - r, by + r, p.z0_m, p.z1_m)
+                elif isinstance(p, Prism) and not gears_only:
+                    r = max(math.hypot(x, y) for x, y in p.outline_m)
                     grow(bx - r, bx + r, by - r, by + r, p.z0_m, p.z1_m)
         if gears_only:
             return (tuple(lo), tuple(hi))
@@ -218,14 +271,27 @@ def tooth_angle_rad(gear: str, tooth: int, teeth: int, sense: int, centre_line_r
 
 def build_layout(scenario: Scenario) -> Layout:
     """The 3D layout of a scenario's drive (see the module docstring)."""
+    from .planetary import attach_z_m, side_depth_m, stage_bodies
+
     stages = scenario.stages
     d = scenario.design
-    mods = [module_m(st.pinion.base_radius_m, st.pinion.teeth, st.mesh.pressure_angle_deg) for st in stages]
-    widths = [
-        (st.pinion.face_width_m or 10 * m, st.wheel.face_width_m or 10 * m)
-        for st, m in zip(stages, mods, strict=True)
+    planetary = [isinstance(st, PlanetaryStage) for st in stages]
+    mods = [
+        st.module_mm * 1e-3
+        if planetary[k]
+        else module_m(st.pinion.base_radius_m, st.pinion.teeth, st.mesh.pressure_angle_deg)
+        for k, st in enumerate(stages)
     ]
-    faces = [max(b) for b in widths]
+    widths = [
+        (10 * m, 10 * m)
+        if planetary[k]
+        else (st.pinion.face_width_m or 10 * m, st.wheel.face_width_m or 10 * m)
+        for k, (st, m) in enumerate(zip(stages, mods, strict=True))
+    ]
+    # a planetary stage's axial room includes its carrier plate (and a turning ring's drum)
+    faces = [
+        2 * side_depth_m(st, widths[k][0]) if planetary[k] else max(widths[k]) for k, st in enumerate(stages)
+    ]
     gap = 0.5 * max(faces)
     z_stage = [0.0]  # axial position of each stage's mid-plane
     for k in range(1, len(stages)):
@@ -239,21 +305,38 @@ def build_layout(scenario: Scenario) -> Layout:
     for st in reversed(stages):
         torques.insert(0, torques[0] / st.ratio)
     axes = [(0.0, 0.0)]  # axis positions: one centre distance per stage along its centre line
-    for st in stages:
+    for k, st in enumerate(stages):
+        if planetary[k]:  # coaxial: the output shaft continues the input's axis
+            axes.append(axes[-1])
+            continue
         gam = math.radians(st.mesh.centre_line_deg)
         a = (st.pinion.base_radius_m + st.wheel.base_radius_m) / math.cos(
             math.radians(st.mesh.pressure_angle_deg)
         )
         axes.append((axes[-1][0] + a * math.cos(gam), axes[-1][1] + a * math.sin(gam)))
-    # the input shaft turns as stage 1's line of action says (the lateral models' convention);
-    # every further axis turns the other way
-    senses = [mesh_directions(stages[0].mesh.centre_line_deg, stages[0].mesh.line_of_action_deg)[2]]
-    for _ in stages:
-        senses.append(-senses[-1])
+    senses, mirrors = _axis_senses(stages)
     names = [("pinion", "wheel")] + [(f"pinion_{k + 1}", f"wheel_{k + 1}") for k in range(1, len(stages))]
+    # the bodies on each stage's input and output shaft, and their model angle per unit chain angle
+    # (a planetary member's angle is absolute, counter-clockwise: s_in or s_out times the chain's)
+    ends = []
+    for k, st in enumerate(stages):
+        if planetary[k]:
+            p = "" if k == 0 else f"stage_{k + 1}_"
+            ends.append((p + st.input, st.input_sense, p + st.output, st.output_sense))
+        else:
+            ends.append((names[k][0], 1, names[k][1], 1))
 
     def root_radius(gear, m):
         return 0.5 * m * gear.teeth - 1.25 * m
+
+    def shaft_cap(k: int, end: int) -> float:
+        """Largest drawn radius of stage k's input (end 0) or output (end 1) shaft: 0.8 of its gear's
+        root radius (a planetary stage's sun; its ring or carrier: none)."""
+        st = stages[k]
+        if planetary[k]:
+            member = (st.input, st.output)[end]
+            return 0.8 * (0.5 * mods[k] * st.sun.teeth - 1.25 * mods[k]) if member == "sun" else math.inf
+        return 0.8 * root_radius((st.pinion, st.wheel)[end], mods[k])
 
     def hub(z0, z1, r):
         """Coupling half with a marker stripe that shows its rotation."""
@@ -263,11 +346,13 @@ def build_layout(scenario: Scenario) -> Layout:
         )
 
     layout = Layout(lateral_scale=scenario.visual.lateral_scale)
+    if planetary[0]:
+        layout.mesh_pair = ("sun", "planet_1")
     power_kW = d.machine.rated_torque_Nm / scenario.gear_ratio * d.motor.synchronous_speed_rad_s / 1e3
     frame_d = 0.13 * max(power_kW, 0.5) ** (1 / 3)  # IEC frame diameter ~ P^(1/3): 75 kW -> 0.55 m
 
     # motor rotor: shaft stub and coupling half
-    r_in = min(shaft_radius_m(torques[0]), 0.8 * root_radius(stages[0].pinion, mods[0]))
+    r_in = min(shaft_radius_m(torques[0]), shaft_cap(0, 0))
     hub_len = 1.6 * r_in
     z_cpl_in = z_front - wall / 2 - 0.5 * gap - hub_len
     z_motor = z_cpl_in - hub_len - 0.4 * gap
@@ -282,13 +367,66 @@ def build_layout(scenario: Scenario) -> Layout:
                 Cylinder(z_motor, z_cpl_in - hub_len, r_in, SHAFT),
                 *hub(z_cpl_in - hub_len, z_cpl_in - 0.002, r_in),
             ),
-            follows="pinion",
+            follows=ends[0][0],
+            ratio=float(ends[0][1]),
         )
     )
+    layout.input_signal, layout.input_factor = f"{ends[0][0]}_angle_rad", ends[0][1]
 
-    # gears with their shafts; bearings in both housing walls, once per axis
+    # gears with their shafts; bearings in both housing walls, once per axis (coaxial axes share them)
     axis_shaft_r: dict[int, float] = {}
+    wall_shaft_r: dict[int, list[float]] = {}  # an axis through a planetary stage: [front, back] shafts
+    axis_key = list(range(len(axes)))  # a planetary stage's output axis is its input axis
+
+    def add_planetary(k: int) -> None:
+        """Stage k's sun, ring, carrier and planets, its input shaft from the front (the coupling or
+        the middle between stages) and its output shaft to the back."""
+        st, b = stages[k], widths[k][0]
+        radius = {
+            st.input: min(shaft_radius_m(torques[k]), shaft_cap(k, 0)),
+            st.output: min(shaft_radius_m(torques[k + 1]), shaft_cap(k, 1)),
+        }
+        z_in, z_out = (attach_z_m(st, m, z_stage[k], b) for m in (st.input, st.output))
+        r_i, r_o = radius[st.input], radius[st.output]
+        if k == 0:
+            shaft_in = (
+                Cylinder(z_cpl_in, z_in, r_i, SHAFT),
+                *hub(z_cpl_in + 0.002, z_cpl_in + hub_len, r_in),
+            )
+        else:
+            shaft_in = (Cylinder(0.5 * (z_stage[k - 1] + z_stage[k]), z_in, r_i, SHAFT),)
+        if k == len(stages) - 1:
+            z_cpl_out = z_back + wall / 2 + 0.5 * gap + 1.6 * r_o
+            shaft_out = (
+                Cylinder(z_out, z_cpl_out, r_o, SHAFT),
+                *hub(z_cpl_out - 1.6 * r_o, z_cpl_out - 0.002, r_o),
+            )
+        else:
+            shaft_out = (Cylinder(z_out, 0.5 * (z_stage[k] + z_stage[k + 1]), r_o, SHAFT),)
+        follows = None if k == 0 else (ends[k - 1][2], float(st.input_sense * ends[k - 1][3]))
+        layout.bodies.extend(
+            stage_bodies(
+                st,
+                k,
+                axes[k],
+                z_stage[k],
+                b,
+                mirrors[k],
+                {st.input: shaft_in, st.output: shaft_out},
+                radius,
+                follows,
+            )
+        )
+        axis_key[k + 1] = axis_key[k]
+        key = axis_key[k]  # the front wall holds the axis's first shaft, the back wall this output's
+        front = wall_shaft_r[key][0] if key in wall_shaft_r else axis_shaft_r.get(key, r_i)
+        wall_shaft_r[key] = [front, r_o]
+        axis_shaft_r[key] = max(axis_shaft_r.get(key, 0.0), r_i, r_o)
+
     for k, st in enumerate(stages):
+        if planetary[k]:
+            add_planetary(k)
+            continue
         gam = math.radians(st.mesh.centre_line_deg)
         m = mods[k]
         marks = {(t.gear, t.tooth): DAMAGED for t in st.damaged_teeth if t.stiffness_factor < 1}
@@ -337,17 +475,21 @@ def build_layout(scenario: Scenario) -> Layout:
                 else (
                     (names[k][0], st.pinion.teeth / st.wheel.teeth)
                     if which == "wheel"
-                    else (names[k - 1][1], 1.0)
+                    else (ends[k - 1][2], float(ends[k - 1][3]))
                 )
             )
             lateral = (f"{name}_x_m", f"{name}_y_m") if gear.lateral != "none" else None
             layout.bodies.append(
                 Body(name, axes[j], senses[j], f"{name}_angle_rad", tuple(parts), lateral, follows, ratio)
             )
-            axis_shaft_r[j] = max(axis_shaft_r.get(j, 0.0), shaft_r)
+            if axis_key[j] in wall_shaft_r and which == "pinion":  # after a planetary stage
+                wall_shaft_r[axis_key[j]][1] = shaft_r
+            axis_shaft_r[axis_key[j]] = max(axis_shaft_r.get(axis_key[j], 0.0), shaft_r)
 
     for j, shaft_r in axis_shaft_r.items():
-        for zw in (z_front, z_back):
+        for w, zw in enumerate((z_front, z_back)):
+            if j in wall_shaft_r:
+                shaft_r = wall_shaft_r[j][w]
             layout.ground.append(
                 Cylinder(
                     zw - wall / 2,
@@ -361,7 +503,7 @@ def build_layout(scenario: Scenario) -> Layout:
             )
 
     # driven machine: coupling half and shaft stub
-    r_out = min(shaft_radius_m(torques[-1]), 0.8 * root_radius(stages[-1].wheel, mods[-1]))
+    r_out = min(shaft_radius_m(torques[-1]), shaft_cap(len(stages) - 1, 1))
     z_cpl_out = z_back + wall / 2 + 0.5 * gap + 1.6 * r_out
     mach_d = 1.1 * frame_d
     z_mach = z_cpl_out + 1.6 * r_out + 0.4 * gap
@@ -375,12 +517,13 @@ def build_layout(scenario: Scenario) -> Layout:
                 *hub(z_cpl_out + 0.002, z_cpl_out + 1.6 * r_out, r_out),
                 Cylinder(z_cpl_out + 1.6 * r_out, z_mach, r_out, SHAFT),
             ),
-            follows=names[-1][1],
+            follows=ends[-1][2],
+            ratio=float(ends[-1][3]),
         )
     )
 
     # housing, motor and machine frames standing on a base plate
-    rmax = max(p.tip_radius_m for _, p in layout.gears)
+    rmax = max(p.outer_radius_m for _, p in layout.gears)
     margin = 0.1 * rmax + 0.03
     xs, ys = [x for x, _ in axes], [y for _, y in axes]
     hx0, hx1 = min(xs) - rmax - margin, max(xs) + rmax + margin
@@ -420,3 +563,29 @@ def build_layout(scenario: Scenario) -> Layout:
         Box(((xlo + xhi) / 2, floor - 0.02, (zlo + zhi) / 2), (xhi - xlo, 0.04, zhi - zlo), BASE)
     )
     return layout
+
+
+def _axis_senses(stages) -> tuple[list[int], list[int]]:
+    """Drawn turning sense of every axis (positive: counter-clockwise seen from the machine side) and
+    the mirror of every stage (-1: a planetary stage drawn mirrored, 1 otherwise).
+
+    Without planetary stages the input shaft turns as stage 1's line of action says (the lateral
+    models' convention) and every further axis the other way. With them, the first planetary stage's
+    input turns in its modelled sense s_in (parallel stages are then torsional, sense-free), the axes
+    before it alternating back to the motor; a later planetary stage whose input turns the other way
+    is drawn mirrored."""
+    first = next((k for k, st in enumerate(stages) if isinstance(st, PlanetaryStage)), None)
+    if first is None:
+        senses = [mesh_directions(stages[0].mesh.centre_line_deg, stages[0].mesh.line_of_action_deg)[2]]
+        for _ in stages:
+            senses.append(-senses[-1])
+        return senses, [1] * len(stages)
+    senses, mirrors = [stages[first].input_sense * (-1) ** first], []
+    for st in stages:
+        if isinstance(st, PlanetaryStage):
+            mirrors.append(senses[-1] * st.input_sense)
+            senses.append(mirrors[-1] * st.output_sense)
+        else:
+            mirrors.append(1)
+            senses.append(-senses[-1])
+    return senses, mirrors

@@ -38,11 +38,15 @@ def check_frames(frames: int, width_px: int, height_px: int, movie: str = "none"
 
 
 def frame_times(
-    result: Result, frames: int, start_s: float | None = None, end_s: float | None = None
+    result: Result,
+    frames: int,
+    start_s: float | None = None,
+    end_s: float | None = None,
+    input_signal: str = "pinion_angle_rad",
 ) -> np.ndarray:
     """``frames`` equally spaced times in [start_s, end_s] of the result.
 
-    Default window: one revolution of the input (pinion) shaft at its mean speed, ending at the end
+    Default window: one revolution of the input shaft (``input_signal``) at its mean speed, ending at the end
     of the result, so the default animation shows the drive running in steady state (capped at the
     result's length); its first frame is one step after the window's start, so a looping animation
     does not show the same pose twice.
@@ -55,7 +59,7 @@ def frame_times(
     if end_s is None:
         end_s = t1
     if start_s is None:
-        phi = result["pinion_angle_rad"]
+        phi = result[input_signal]
         tail = t >= t1 - 0.1 * (t1 - t0)
         speed = abs(phi[tail][-1] - phi[tail][0]) / max(t[tail][-1] - t[tail][0], 1e-12)
         span = 2 * math.pi / speed if speed > 1e-9 else t1 - t0
@@ -89,7 +93,9 @@ def body_angles_rad(layout: Layout, result: Result, times: np.ndarray) -> dict[s
             progress = True
         if not progress:
             missing = ", ".join(b.angle_signal for b in pending)
-            raise RenderError(f"the result has no rotation for {missing} (needs at least 'pinion_angle_rad')")
+            raise RenderError(
+                f"the result has no rotation for {missing} (needs at least {layout.input_signal!r})"
+            )
     return out
 
 
@@ -105,24 +111,52 @@ def body_poses(
     With ``lateral_about_mean`` (default) the gear centres move about their mean position over
     ``times``: the vibration is magnified, not the static bearing deflection under load (which at
     x1000 would push the drawn teeth out of mesh).
+
+    A planet rides on the drawn carrier: its centre is the carrier's pin point (the carrier's drawn,
+    magnified centre, turned by the drawn carrier angle), plus its own true bearing deflection
+    (centre signal minus the pin point of the true carrier centre); without magnification it is
+    exactly its centre signal.
     """
     scale = layout.lateral_scale if lateral_scale is None else lateral_scale
     if not scale >= 0:
         raise RenderError(f"lateral_scale = {scale:g}: must be >= 0")
     angles = body_angles_rad(layout, result, times)
     poses = np.zeros((len(times), 3 * len(layout.bodies)))
+    index = {b.name: k for k, b in enumerate(layout.bodies)}
+
+    def signal(name):
+        return np.interp(times, result.time_s, result[name]) if name in result else None
+
     for k, b in enumerate(layout.bodies):
         if b.lateral_signals:
             for d, name in enumerate(b.lateral_signals):
-                if name in result:
-                    u = np.interp(times, result.time_s, result[name])
+                u = signal(name)
+                if u is not None:
+                    u = u * (b.mirror if d == 1 else 1)
                     poses[:, 3 * k + d] = scale * (u - u.mean() if lateral_about_mean else u)
         poses[:, 3 * k + 2] = b.sense * angles[b.name]
+    for k, b in enumerate(layout.bodies):
+        if b.orbit is None:
+            continue
+        o, c = b.orbit, index[b.orbit.carrier]
+        carrier = layout.bodies[c]
+        drawn = poses[:, 3 * c : 3 * c + 3]  # the carrier's drawn offset and angle
+        true = [signal(n) for n in (*(carrier.lateral_signals or ()), *o.centre_signals)]
+        if all(u is not None for u in true):  # the centre signal, moved as the carrier's drawing is
+            cx, cy, px, py = true
+            pin = np.column_stack([px - cx, b.mirror * (py - cy)]) + drawn[:, :2]
+        else:  # on its pin, the carrier rigid
+            turn = drawn[:, 2] + o.angle_rad
+            pin = drawn[:, :2] + o.radius_m * np.column_stack([np.cos(turn), np.sin(turn)])
+        centre = np.asarray(o.centre_xy_m) + pin
+        poses[:, 3 * k : 3 * k + 2] = centre - np.asarray(b.axis_xy_m)
     return poses
 
 
-def kinematic_result(speed_rad_s: float, duration_s: float, samples: int = 2001) -> Result:
+def kinematic_result(
+    speed_rad_s: float, duration_s: float, samples: int = 2001, signal: str = "pinion_angle_rad"
+) -> Result:
     """A result of rigid rotation at ``speed_rad_s`` of the input shaft (no simulation): pictures of
-    the machine alone."""
+    the machine alone. ``signal`` names the input's rotation (``Layout.input_signal``)."""
     t = np.linspace(0.0, duration_s, samples)
-    return Result(time_s=t, signals={"pinion_angle_rad": speed_rad_s * t}, meta={"kinematic": True})
+    return Result(time_s=t, signals={signal: speed_rad_s * t}, meta={"kinematic": True})

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .layout import Box, Cylinder, GearShape, Layout
+from .layout import Box, Cylinder, GearShape, Layout, Prism
 from .poses import RenderError
 
 VIEWS = {  # azimuth, elevation in degrees: the eye's direction from the drive's centre
@@ -79,9 +79,48 @@ def _rotation_vector(R: np.ndarray) -> list[float]:
     return list(RotationMatrix2RotationVector(R))
 
 
+def _outline_gear_graphics(gear: GearShape):
+    """A gear from gearbody's involute outline: external with its bore, or internal in its rim."""
+    import exudyn.graphics as gr
+
+    from .planetary import tooth_outline
+
+    m, r = gear.module_m, gear.pitch_radius_m
+    r_out, r_in = (r + 1.25 * m, r - m) if gear.internal else (r + m, r - 1.25 * m)
+    outline = tooth_outline(gear.teeth, m, gear.pressure_angle_deg, r_out, r_in)
+    # an internal gear's lobes are its tooth spaces, half a pitch from its teeth
+    offset = gear.first_tooth_rad + (math.pi / gear.teeth if gear.internal else 0.0)
+    c, s = math.cos(offset), math.sin(offset)
+    points = (outline @ np.array([[c, s], [-s, c]])).tolist()
+    n = len(points)
+    segments = [[i, (i + 1) % n] for i in range(n)]
+    circle = gear.rim_radius_m if gear.internal else gear.bore_radius_m
+    if circle > 0:
+        a = np.linspace(0.0, 2 * math.pi, 64, endpoint=False)
+        ring = np.column_stack([circle * np.cos(a), circle * np.sin(a)])
+        if not gear.internal:  # a hole: clockwise
+            ring = ring[::-1]
+        points += ring.tolist()
+        segments += [[n + i, n + (i + 1) % len(ring)] for i in range(len(ring))]
+    if gear.internal:  # the outline bounds a hole: clockwise
+        segments = [[j, i] for i, j in segments[:n]] + segments[n:]
+    return [
+        gr.SolidExtrusion(
+            points,
+            segments,
+            gear.face_width_m,
+            pOff=[0, 0, gear.z_m - gear.face_width_m / 2],
+            color=list(gear.colour),
+        )
+    ]
+
+
 def _gear_graphics(gear: GearShape):
     import exudyn.graphics as gr
     import exudyn.machines as machines
+
+    if gear.outline == "gearbody":
+        return _outline_gear_graphics(gear)
 
     geometry = machines.InvoluteGear(
         module=gear.module_m, nTeeth=gear.teeth, pressureAngleDeg=gear.pressure_angle_deg
@@ -148,6 +187,19 @@ def _part_graphics(part, offset=(0.0, 0.0)):
                 color=list(part.colour),
                 nTiles=32,
                 **kw,
+            )
+        ]
+    if isinstance(part, Prism):
+        points = [list(p) for p in part.outline_m]
+        n = len(points)
+        segments = [[i, (i + 1) % n] for i in range(n)]
+        if part.hole_radius_m > 0:
+            a = np.linspace(2 * math.pi, 0.0, 48, endpoint=False)  # clockwise: a hole
+            points += [[part.hole_radius_m * math.cos(t), part.hole_radius_m * math.sin(t)] for t in a]
+            segments += [[n + i, n + (i + 1) % 48] for i in range(48)]
+        return [
+            gr.SolidExtrusion(
+                points, segments, part.z1_m - part.z0_m, pOff=[0, 0, part.z0_m], color=list(part.colour)
             )
         ]
     if isinstance(part, Box):
@@ -230,14 +282,15 @@ class VisualSystem:
         vs.openGL.multiSampling = 1
         vs.openGL.light0.position = [-2.0, 6.0, 6.0, 0.0]
 
-    def set_camera(self) -> None:
+    def set_camera(self, pose: np.ndarray | None = None) -> None:
+        """Fit the camera to the framed parts (``pose``: where a revolving mesh is, frame "mesh")."""
         o = self.options
         az, el = VIEWS[o.view]
         az = o.azimuth_deg if o.azimuth_deg is not None else az
         el = o.elevation_deg if o.elevation_deg is not None else el
         R = camera_rotation(az, el)
         if o.frame == "mesh":
-            lo, hi = (np.array(v) for v in self.layout.mesh_bounds_m())
+            lo, hi = (np.array(v) for v in self.layout.mesh_bounds_m(pose=pose))
         else:
             lo, hi = (np.array(v) for v in self.layout.bounds_m(gears_only=o.frame == "gears"))
         centre = 0.5 * (lo + hi)

@@ -84,6 +84,10 @@ def _table(
 
 def report_sections(result: Result) -> dict[str, Any]:
     """The report's content as data: summary, labelled peaks, indicators, and figures (base64 PNG)."""
+    if result.planetary_stages:
+        from .planetary import planetary_report_sections
+
+        return planetary_report_sections(result)
     win = result.final_window()
     summary = result.summary()
     name = result.vibration_signal_name
