@@ -30,20 +30,7 @@ from ..physics.planetary_mesh import stage_forces
 from .build import HIDDEN, BuiltSystem, _add_sensors
 from .user_functions import compiled
 
-__all__ = ["build_compound", "planetary_stage_user_function"]
-
-
-def planetary_stage_user_function(link: PlanetaryLink):
-    """The force function of one planetary stage's item: coordinates are displacements from the nominal
-    assembly, the compiled law takes absolute ones."""
-    ref, G = link.reference(), link.geometry_rows()
-    Ps, Pr = link.layout.mesh_arrays()
-    forces = compiled(stage_forces, ref, ref, G, Ps, Pr)
-
-    def stage_items(mbs, t, itemNumber, q, q_t):
-        return forces(np.asarray(q) + ref, np.asarray(q_t), G, Ps, Pr)
-
-    return stage_items
+__all__ = ["build_compound", "drive_user_function"]
 
 
 def drive_user_function(layout: CompoundLayout, watchdog):
@@ -61,9 +48,9 @@ def drive_user_function(layout: CompoundLayout, watchdog):
     stages = []
     for link in layout.planetary:
         ref, G = link.reference(), link.geometry_rows()
-        Ps, Pr = link.layout.sun_mesh, link.layout.ring_mesh
-        stages.append((link.first, link.first + link.size, ref, G, Ps, Pr))
-    forces = compiled(stage_forces, stages[0][2], stages[0][2], stages[0][3], stages[0][4], stages[0][5])
+        Ps, Pr = link.layout.mesh_arrays()  # shared laws, or one row per planet (faulted planet teeth)
+        forces = compiled(stage_forces, ref, ref, G, Ps, Pr)  # for this stage's array shapes
+        stages.append((link.first, link.first + link.size, ref, G, Ps, Pr, forces))
     tick, check = watchdog.ticker()
 
     def drive_items(mbs, t, itemNumber, q, q_t):
@@ -77,7 +64,7 @@ def drive_user_function(layout: CompoundLayout, watchdog):
             a, b = mesh_forces(q[ip], q[iw], q_t[ip], q_t[iw], P)
             f[ip] += a
             f[iw] += b
-        for a, b, ref, G, Ps, Pr in stages:
+        for a, b, ref, G, Ps, Pr, forces in stages:
             f[a:b] += forces(q[a:b] + ref, q_t[a:b], G, Ps, Pr)
         return f
 
