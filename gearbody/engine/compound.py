@@ -23,7 +23,7 @@ from exudyn.itemInterface import (
     ObjectRotationalMass1D,
 )
 
-from ..assembly.compound import CompoundLayout, PlanetaryLink, stage_stiffness_matrix
+from ..assembly.compound import CompoundLayout, stage_stiffness_matrix
 from ..physics import load_torque_at, motor_torque_at
 from ..physics.mesh import I_R1, I_R2, mean_stiffness_N_per_m, torsional_mesh_forces
 from ..physics.planetary_mesh import stage_forces
