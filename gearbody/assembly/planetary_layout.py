@@ -303,15 +303,13 @@ def layout_from_stage(stage, stage_index: int, seed: int, *, modal: bool = False
     from ..physics.error_mode import planetary_tooth_error_depths_m
     from ..physics.mesh import mean_stiffness_N_per_m
 
+    members = {name: _member(name, getattr(stage, name)) for name in ("sun", "ring", "carrier", "planet")}
     if modal:
         full = layout_from_stage(stage, stage_index, seed)
         k_mean = (mean_stiffness_N_per_m(full.sun_mesh), mean_stiffness_N_per_m(full.ring_mesh))
         return layout_from_geometry(
             stage.geometry,
-            sun=_member("sun", stage.sun),
-            ring=_member("ring", stage.ring),
-            carrier=_member("carrier", stage.carrier),
-            planet=_member("planet", stage.planet),
+            **members,
             stiffness_single_N_per_m=k_mean,
             stiffness_double_N_per_m=k_mean,
             bearing_factors=stage.bearing_factors() if stage.planet_bearing_defects else (),
@@ -327,10 +325,7 @@ def layout_from_stage(stage, stage_index: int, seed: int, *, modal: bool = False
     )
     return layout_from_geometry(
         stage.geometry,
-        sun=_member("sun", stage.sun),
-        ring=_member("ring", stage.ring),
-        carrier=_member("carrier", stage.carrier),
-        planet=_member("planet", stage.planet),
+        **members,
         stiffness_single_N_per_m=tuple(m.stiffness_single_N_per_m for m in meshes),
         stiffness_double_N_per_m=tuple(m.stiffness_double_N_per_m for m in meshes),
         damping_Ns_per_m=tuple(m.damping_Ns_per_m for m in meshes),
