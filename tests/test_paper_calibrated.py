@@ -38,8 +38,10 @@ def test_its_values_lie_inside_the_stated_bounds(fit):
     for key in fit.fitted:
         b = cal.BOUND[key]
         if key == cal.RATING.key:  # the rating is stated by the keys it scales
-            scale = _value(data, "design.motor.breakdown_torque_Nm") / cal.SCALED_BY_RATING[
-                "design.motor.breakdown_torque_Nm"]
+            scale = (
+                _value(data, "design.motor.breakdown_torque_Nm")
+                / cal.SCALED_BY_RATING["design.motor.breakdown_torque_Nm"]
+            )
             value = scale * cal.RATED_KW
             for k, v in cal.SCALED_BY_RATING.items():
                 assert _value(data, k) == pytest.approx(v * scale, rel=1e-5), k

@@ -92,8 +92,12 @@ def test_the_strongest_kinematic_lines_are_named():
     spec = amplitude_spectrum(x, fs_hz, window="hann")
     f_max = 6 * f_z
     peaks = label_peaks(
-        spec, spectrum_lines(f_pinion, [(z1, z2)], f_max), tolerance_hz=1.5 * spec.resolution_hz,
-        min_prominence_db=12.0, max_peaks=40, f_max_hz=f_max,
+        spec,
+        spectrum_lines(f_pinion, [(z1, z2)], f_max),
+        tolerance_hz=1.5 * spec.resolution_hz,
+        min_prominence_db=12.0,
+        max_peaks=40,
+        f_max_hz=f_max,
     )
     strongest = sorted(peaks, key=lambda p: -p.amplitude)[: len(tones)]
     assert all(p.explained for p in strongest), [(p.frequency_hz, p.label) for p in strongest]

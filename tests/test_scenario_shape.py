@@ -193,9 +193,12 @@ def test_an_infeasible_drive_is_an_input_error_on_the_command_line(tmp_path, cap
     from gearbody.cli import main
 
     overload = [
-        "--set", 'operation.initial_state="steady"',
-        "--set", "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
-        "--set", "design.machine.rated_torque_Nm=6000",
+        "--set",
+        'operation.initial_state="steady"',
+        "--set",
+        "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
+        "--set",
+        "design.machine.rated_torque_Nm=6000",
     ]
     assert main(["run", "one-stage", *overload, "--t-end", "0.01", "--out", str(tmp_path), "--no-plots"]) == 2
     assert "breakdown torque" in capsys.readouterr().err

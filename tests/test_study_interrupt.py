@@ -86,8 +86,11 @@ def test_a_study_too_big_is_refused_before_anything_is_made(tmp_path, capsys):
     t0 = time.perf_counter()
     with pytest.raises(SweepSpecError, match=rf"count 1000000000 is more than the {MAX_CASES} cases"):
         Study.build(SCENE, vary=[f"{E_UM}=0:20:1000000000"])
-    with pytest.raises(SweepSpecError, match=r"has 1000000000000 cases \(1000000 \(--samples 1000000\) "
-                       rf"x 1000000 \(--seeds 1000000\)\), more than the limit of {MAX_CASES}"):
+    with pytest.raises(
+        SweepSpecError,
+        match=r"has 1000000000000 cases \(1000000 \(--samples 1000000\) "
+        rf"x 1000000 \(--seeds 1000000\)\), more than the limit of {MAX_CASES}",
+    ):
         Study.build(SCENE, random=[f"{E_UM}=uniform(5,15)"], samples=10**6, seeds=10**6)
     with pytest.raises(SweepSpecError, match=r"has 10100 cases .*--max-cases 10100"):
         Study.build(SCENE, vary=[f"{E_UM}=0:20:101"], seeds=100)
@@ -112,7 +115,11 @@ def _sweep(out: Path, *extra: str) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     return subprocess.Popen(  # its own process group: a Ctrl-C reaches it and its workers only
         [*cmd, *extra, "--out", str(out)],
-        env=env, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env=env,
+        start_new_session=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
 
 
@@ -195,11 +202,19 @@ def test_an_interrupted_and_worker_killed_study_resumes_to_the_uninterrupted_res
     runs = [set(first), set(second) - set(first) - {killed}, {killed}]
     assert sum(len(r) for r in runs) == 8 and set().union(*runs) == set(third)
     ref = tmp_path / "ref"
-    run_study(SCENE, out_dir=ref, vary=[VARY], base_overrides=[f"operation.t_end_s={float(T_END)!r}"],
-              workers=1, progress=False)
+    run_study(
+        SCENE,
+        out_dir=ref,
+        vary=[VARY],
+        base_overrides=[f"operation.t_end_s={float(T_END)!r}"],
+        workers=1,
+        progress=False,
+    )
     for case in sorted(third):
-        with np.load(out / "cases" / case / "result.npz") as a, np.load(ref / "cases" / case /
-                                                                        "result.npz") as b:
+        with (
+            np.load(out / "cases" / case / "result.npz") as a,
+            np.load(ref / "cases" / case / "result.npz") as b,
+        ):
             assert sorted(a.files) == sorted(b.files)
             for name in a.files:
                 if name == "meta_json":
@@ -230,9 +245,12 @@ def test_a_case_whose_dask_workers_die_is_failed_once_with_the_cause_and_the_oth
     # worker-saturation 1: a worker holds only the task it runs (Dask counts a death against every task
     # the worker holds: with queued tasks, an innocent neighbour of the killer can fail too)
     config = {"distributed.scheduler.allowed-failures": 1, "distributed.scheduler.worker-saturation": 1.0}
-    with dask.config.set(config), LocalCluster(
-        n_workers=2, processes=True, threads_per_worker=1, host="127.0.0.1", dashboard_address=":0"
-    ) as cluster:
+    with (
+        dask.config.set(config),
+        LocalCluster(
+            n_workers=2, processes=True, threads_per_worker=1, host="127.0.0.1", dashboard_address=":0"
+        ) as cluster,
+    ):
         outcomes = list(executors.run_dask(_dask_task, jobs, cluster.scheduler_address))
     assert sorted(jid for jid, _ in outcomes) == [jid for jid, _ in jobs]  # each job once
     by_id = dict(outcomes)
@@ -245,8 +263,13 @@ def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path):
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "gearbody.cli", "run", SCENE, "--t-end", "20", "--no-plots"]
     cmd += ["--out", str(out)]
-    proc = subprocess.Popen(cmd, env={**os.environ, "PYTHONPATH": str(ROOT)}, start_new_session=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        cmd,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        start_new_session=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     seen = b""
     while b"simulating" not in seen:  # the progress bar: the solver has run for 2 s
         chunk = proc.stderr.read1(4096)

@@ -32,8 +32,9 @@ def one_stage_as_train(*overrides):
     design["shafts"] = [design.pop("coupling"), design.pop("output_shaft")]
     design["stages"] = [stage]
     d["meta"]["name"] = "one-stage"
-    stage_overrides = [o.replace("condition.damaged_teeth", "design.stages.1.damaged_teeth")
-                       for o in overrides]
+    stage_overrides = [
+        o.replace("condition.damaged_teeth", "design.stages.1.damaged_teeth") for o in overrides
+    ]
     return sc, load_scenario(d, stage_overrides)
 
 

@@ -134,12 +134,15 @@ def line_table(res: PhasingResult, harmonics: int = 2, span: int = 4) -> str:
     McFadden-Smith rule lets each survive ((k Z_r + q) mod N == 0)."""
     zr, n = res.teeth[2], 3
     peak = max(res.sensor_at(k * zr + q) for k in range(1, harmonics + 1) for q in range(-span, span + 1))
-    rows = ["| line | order | amplitude [N] | relative | rule |", "|---|---|---|---|---|"]
+    rows = [
+        "| line k f_m + q f_c | order k Z_r + q | amplitude [N] | relative | rule |",
+        "|---|---|---|---|---|",
+    ]
     for k in range(1, harmonics + 1):
         for q in range(-span, span + 1):
             order = k * zr + q
             a = res.sensor_at(order)
-            name = f"{k} f_m" + (f" {'+' if q > 0 else '-'} {abs(q)} f_c" if q else "")
+            name = f"k = {k}, q = {q:+d}"  # the line k f_m + q f_c
             rule = "survives" if order % n == 0 else "cancelled"
             rows.append(f"| {name} | {order} | {a:.4g} | {a / peak:.3g} | {rule} |")
     return "\n".join(rows)

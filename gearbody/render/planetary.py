@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ..model.planetary import PlanetaryStage
-from .layout import MARKER, STEEL, WHEEL, Body, Cylinder, GearShape, Orbit, Prism
+from .shapes import MARKER, STEEL, WHEEL, Body, Cylinder, GearShape, Orbit, Prism
 
 RING = (0.5, 0.52, 0.56, 1.0)
 CARRIER = (0.2, 0.45, 0.48, 1.0)
