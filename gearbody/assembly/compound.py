@@ -21,7 +21,7 @@ from ..errors import InputError
 from ..model import Scenario
 from ..model.planetary import PlanetaryStage
 from ..physics.mesh import I_LU
-from ..physics.planetary_mesh import G_DELTA0_RING, G_DELTA0_SUN, stage_forces
+from ..physics.planetary_mesh import G_BEARING_K, G_DELTA0_RING, G_DELTA0_SUN, stage_forces
 from .operating_point import static_deflection_m, steady_operating_point
 from .parameters import mesh_parameters_from_scenario, pack_drive_parameters
 from .planetary_layout import CENTRAL, PlanetaryLayout, layout_from_stage
@@ -33,6 +33,8 @@ __all__ = [
     "PlanetaryLink",
     "compound_initial_state",
     "compound_layout",
+    "bearing_law_forces",
+    "has_bearing_laws",
     "stage_stiffness_matrix",
     "planetary_member_names",
     "stage_prefix",
@@ -40,6 +42,9 @@ __all__ = [
 
 
 MAX_NEWTON_ITERATIONS = 30
+REGULARISING_N_PER_M = 1e7
+LAW_NEWTON_ITERATIONS = 300
+"""The weak spring of the static start's first pass on members that sit on bearing laws, N/m."""
 STATIC_TOLERANCE = 1e-9
 """Largest residual force of the static start, relative to the stage's largest external torque (N or
 N m per N m)."""
@@ -196,21 +201,76 @@ def compound_layout(scenario: Scenario, *, modal: bool = False) -> CompoundLayou
     )
 
 
-def stage_stiffness_matrix(link: PlanetaryLink, step: float = 1e-7) -> np.ndarray:
+def stage_stiffness_matrix(
+    link: PlanetaryLink, step: float = 1e-7, bearing_state: np.ndarray | None = None
+) -> np.ndarray:
     """-d(forces)/dq of a planetary stage's meshes and planet bearings at the nominal assembly, by central
     differences (``step`` m on centres, m / r_c on rotations): with ``compound_layout(..., modal=True)``
     the meshes are springs at their mean stiffness through zero deflection, so this is the exact
-    geometry's linearisation (Lin & Parker's matrices in the fixed frame) to O(step^2)."""
+    geometry's linearisation (Lin & Parker's matrices in the fixed frame) to O(step^2). Bearing laws
+    (``bearing_law_forces``) are linearised at ``bearing_state`` (displacements; default nominal), e.g.
+    the static state under the rated load, where a bearing with clearance carries its load."""
     ref, G = link.reference(), link.geometry_rows()
     Ps, Pr = link.layout.mesh_arrays()
     zero = np.zeros(link.size)
+    at = np.zeros(link.size) if bearing_state is None else bearing_state
+    laws = has_bearing_laws(link)
     K = np.empty((link.size, link.size))
     for j in range(link.size):
         h = step if j % 3 < 2 else step / link.layout.carrier_radius_m
         e = np.zeros(link.size)
         e[j] = h
         K[:, j] = -(stage_forces(ref + e, zero, G, Ps, Pr) - stage_forces(ref - e, zero, G, Ps, Pr)) / (2 * h)
+        if laws:
+            K[:, j] -= (bearing_law_forces(link, at + e, zero) - bearing_law_forces(link, at - e, zero)) / (
+                2 * h
+            )
     return K
+
+
+def has_bearing_laws(link: PlanetaryLink) -> bool:
+    """True when a member of the stage sits on a bearing law (not the linear isotropic bearing)."""
+    return any(m.bearing_law is not None for m in (*link.layout.members, link.layout.planet))
+
+
+def bearing_law_forces(link: PlanetaryLink, q_rel: np.ndarray, q_t: np.ndarray) -> np.ndarray:
+    """Generalised forces of the stage's bearing laws (docs/planetary.md, "Bearing laws"), on its
+    coordinates (``q_rel``: displacements from the nominal assembly, ``q_t``: velocities). A central
+    member's law takes its centre's displacement and velocity (the housing is fixed); a planet's law takes
+    its centre's offset from its pin, e = c_n - P_n, and its rate, both turned into the carrier frame
+    (angle theta_c + pin angle), and its force, turned back, acts on the planet and, reversed, on the
+    carrier at the pin (with the moment (P_n - c_c) x (-F))."""
+    lay = link.layout
+    f = np.zeros(link.size)
+    for m, member in enumerate(lay.members):
+        if member.bearing_law is not None:
+            o = 3 * m
+            f[o : o + 2] += member.bearing_law.force_N(q_rel[o : o + 2], q_t[o : o + 2])
+    law = lay.planet.bearing_law
+    if law is None:
+        return f
+    rc = lay.carrier_radius_m
+    xc, yc, tc = q_rel[6], q_rel[7], q_rel[8]  # the carrier's nominal centre and rotation are 0
+    vxc, vyc, wc = q_t[6], q_t[7], q_t[8]
+    for n in range(len(lay.planet_angles_rad)):
+        b = 9 + 3 * n
+        a = tc + lay.pin_angle_rad(n)
+        c, s_ = np.cos(a), np.sin(a)
+        px, py = lay.planet_centre_m(n)
+        ex = px + q_rel[b] - (xc + rc * c)
+        ey = py + q_rel[b + 1] - (yc + rc * s_)
+        vx = q_t[b] - (vxc - rc * s_ * wc)
+        vy = q_t[b + 1] - (vyc + rc * c * wc)
+        u = np.array([c * ex + s_ * ey, -s_ * ex + c * ey])  # carrier frame: radial, tangential
+        du = np.array([c * vx + s_ * vy, -s_ * vx + c * vy])
+        fr, ft = law.force_N(u, du)
+        Fx, Fy = c * fr - s_ * ft, s_ * fr + c * ft  # on the planet, fixed frame
+        f[b] += Fx
+        f[b + 1] += Fy
+        f[6] -= Fx
+        f[7] -= Fy
+        f[8] -= rc * (c * Fy - s_ * Fx)
+    return f
 
 
 def _support_forces(link: PlanetaryLink, q_rel: np.ndarray) -> np.ndarray:
@@ -222,6 +282,8 @@ def _support_forces(link: PlanetaryLink, q_rel: np.ndarray) -> np.ndarray:
         f[o : o + 2] -= member.bearing_stiffness_N_per_m * q_rel[o : o + 2]
         if member.torsion_stiffness_Nm_per_rad is not None:
             f[o + 2] -= member.torsion_stiffness_Nm_per_rad * q_rel[o + 2]
+    if has_bearing_laws(link):
+        f += bearing_law_forces(link, q_rel, np.zeros(link.size))
     return f
 
 
@@ -262,25 +324,53 @@ def stage_static_displacements(
         c = ref + q
         f[9::3] += w2 * (c[9::3] - c[6])
         f[10::3] += w2 * (c[10::3] - c[7])
+        f[soft] -= regularise[0] * q[soft]
         return f[free]
 
+    # A bearing law with a clearance carries nothing at the nominal assembly (its members then hang on
+    # the meshes alone, the carrier on nothing): first solved with a weak spring (REGULARISING_N_PER_M)
+    # on every translation of a member on a law, then without it from there (the bearings in contact).
+    lay = link.layout
+    soft = np.array(
+        [3 * m + d for m, mem in enumerate(lay.members) if mem.bearing_law for d in (0, 1)], dtype=int
+    )
+    regularise = [REGULARISING_N_PER_M if has_bearing_laws(link) else 0.0]
+    G_soft = G.copy()
+    if lay.planet.bearing_law is not None:  # the planets' weak spring acts on their pins (the carrier)
+        G_soft[:, G_BEARING_K] += REGULARISING_N_PER_M
+    G_free = G
     scale = max(abs(input_torque_Nm), abs(output_torque_Nm), 1.0)
     # Newton with a central-difference Jacobian (the laws are piecewise linear in the deflections, the
     # geometry smooth): steps of 1e-9 m on centres and 1e-9 m / r_c on rotations
     steps = np.array([1e-9 if i % 3 < 2 else 1e-9 / link.layout.carrier_radius_m for i in free])
     x = np.zeros(free.size)
-    r = residual(x)
-    for _ in range(MAX_NEWTON_ITERATIONS):
-        if np.max(np.abs(r)) <= STATIC_TOLERANCE * scale:
-            break
-        J = np.empty((free.size, free.size))
-        for j, h in enumerate(steps):
-            e = np.zeros(free.size)
-            e[j] = h
-            J[:, j] = (residual(x + e) - residual(x - e)) / (2 * h)
-        x = x - np.linalg.solve(J, r)
+
+    def newton(
+        x: np.ndarray, iterations: int = MAX_NEWTON_ITERATIONS, max_step_m: float = np.inf
+    ) -> np.ndarray:
         r = residual(x)
+        for _ in range(iterations):
+            if np.max(np.abs(r)) <= STATIC_TOLERANCE * scale:
+                break
+            J = np.empty((free.size, free.size))
+            for j, h in enumerate(steps):
+                e = np.zeros(free.size)
+                e[j] = h
+                J[:, j] = (residual(x + e) - residual(x - e)) / (2 * h)
+            dx = np.linalg.solve(J, r)
+            longest = np.max(np.abs(dx / steps)) * 1e-9  # in m (rotations times r_c)
+            x = x - dx * min(1.0, max_step_m / longest)
+            r = residual(x)
+        return x
+
+    if regularise[0]:  # steps of at most a micrometre while the bearing contacts close
+        G = G_soft
+        x = newton(x, LAW_NEWTON_ITERATIONS, 1e-6)
+        G, regularise[0] = G_free, 0.0
+        x = newton(x, LAW_NEWTON_ITERATIONS, 1e-6)
+    x = newton(x)
     G, Ps, Pr = G_true, Ps_true, Pr_true
+    x = newton(x)  # with the backlash: one step at most when every loaded mesh is on its flank
     r = residual(x)
     if not np.max(np.abs(r)) <= STATIC_TOLERANCE * scale:
         raise InputError(

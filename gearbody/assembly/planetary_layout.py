@@ -55,6 +55,7 @@ class PlanetaryMember:
     bearing_damping_Ns_per_m: float = 0.0
     torsion_stiffness_Nm_per_rad: float | None = None  # None: free to turn
     torsion_damping_Nms_per_rad: float = 0.0
+    bearing_law: object | None = None  # a gearbody.physics.bearings law replacing the linear bearing
 
 
 @dataclass(frozen=True)
@@ -284,14 +285,17 @@ def ring_wheel_teeth(geometry, n: int) -> np.ndarray:
 
 
 def _member(name: str, m) -> PlanetaryMember:
+    """An assembly member from a scenario member; a bearing law leaves the linear bearing at 0 (the law
+    acts instead, assembly.compound.bearing_law_forces)."""
     return PlanetaryMember(
         name,
         m.mass_kg,
         m.inertia_kg_m2,
-        m.bearing_stiffness_N_per_m,
+        m.bearing_stiffness_N_per_m or 0.0,
         m.bearing_damping_Ns_per_m,
         m.torsion_stiffness_Nm_per_rad,
         m.torsion_damping_Nms_per_rad,
+        None if m.bearing is None else m.bearing.law(),
     )
 
 

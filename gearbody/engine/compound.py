@@ -23,7 +23,7 @@ from exudyn.itemInterface import (
     ObjectRotationalMass1D,
 )
 
-from ..assembly.compound import CompoundLayout, stage_stiffness_matrix
+from ..assembly.compound import CompoundLayout, bearing_law_forces, has_bearing_laws, stage_stiffness_matrix
 from ..physics import load_torque_at, motor_torque_at
 from ..physics.mesh import I_R1, I_R2, mean_stiffness_N_per_m, torsional_mesh_forces
 from ..physics.planetary_mesh import stage_forces
@@ -45,12 +45,14 @@ def drive_user_function(layout: CompoundLayout, watchdog):
     load = compiled(load_torque_at, 0.0, D)
     meshes = [(m.pinion, m.wheel, m.parameters) for m in layout.meshes]
     mesh_forces = compiled(torsional_mesh_forces, 0.0, 0.0, 0.0, 0.0, meshes[0][2]) if meshes else None
-    stages = []
+    stages, laws = [], []
     for link in layout.planetary:
         ref, G = link.reference(), link.geometry_rows()
         Ps, Pr = link.layout.mesh_arrays()  # shared laws, or one row per planet (faulted planet teeth)
         forces = compiled(stage_forces, ref, ref, G, Ps, Pr)  # for this stage's array shapes
         stages.append((link.first, link.first + link.size, ref, G, Ps, Pr, forces))
+        if has_bearing_laws(link):  # Python laws (docs/planetary.md, "Bearing laws")
+            laws.append((link.first, link.first + link.size, link))
     tick, check = watchdog.ticker()
 
     def drive_items(mbs, t, itemNumber, q, q_t):
@@ -66,18 +68,27 @@ def drive_user_function(layout: CompoundLayout, watchdog):
             f[iw] += b
         for a, b, ref, G, Ps, Pr, forces in stages:
             f[a:b] += forces(q[a:b] + ref, q_t[a:b], G, Ps, Pr)
+        for a, b, link in laws:
+            f[a:b] += bearing_law_forces(link, q[a:b], q_t[a:b])
         return f
 
     return drive_items
 
 
 def build_compound(
-    layout: CompoundLayout, q0: np.ndarray, v0: np.ndarray, *, sensors: bool = True, modal: bool = False
+    layout: CompoundLayout,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    *,
+    sensors: bool = True,
+    modal: bool = False,
+    bearing_states: dict[int, np.ndarray] | None = None,
 ) -> BuiltSystem:
     """Exudyn system of a compound layout at initial coordinates ``q0`` and velocities ``v0`` (one per
     coordinate of ``layout.dof_names``). ``modal``: the linearised system for natural frequencies, motor
     and load left out, parallel meshes constant springs at their mean stiffness (the layout's planetary
-    meshes already are, ``compound_layout(..., modal=True)``), linearised by Exudyn at ``q0``."""
+    meshes already are, ``compound_layout(..., modal=True)``), linearised by Exudyn at ``q0``; bearing
+    laws at ``bearing_states[stage]`` (the stage's displacements; default nominal)."""
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
     names = list(layout.dof_names)
@@ -137,7 +148,7 @@ def build_compound(
     for link in layout.planetary:
         for m, member in enumerate(link.layout.members):
             o = link.first + 3 * m
-            for d in (0, 1):
+            for d in (0, 1) if member.bearing_law is None else ():  # a law: in the drive's force item
                 spring(o + d, None, member.bearing_stiffness_N_per_m, member.bearing_damping_Ns_per_m)
             if member.torsion_stiffness_Nm_per_rad is not None:
                 spring(o + 2, None, member.torsion_stiffness_Nm_per_rad, member.torsion_damping_Nms_per_rad)
@@ -168,7 +179,9 @@ def build_compound(
                 ObjectGenericODE2(
                     nodeNumbers=list(dict.fromkeys(node_of[c][0] for c in coordinates)),
                     massMatrix=np.zeros((link.size, link.size)),
-                    stiffnessMatrix=stage_stiffness_matrix(link),
+                    stiffnessMatrix=stage_stiffness_matrix(
+                        link, bearing_state=(bearing_states or {}).get(link.stage)
+                    ),
                     visualization=HIDDEN,
                 )
             )

@@ -25,7 +25,7 @@ from ..assembly import (
     static_lateral_displacements_m,
     torsional_layout,
 )
-from ..assembly.compound import compound_layout
+from ..assembly.compound import compound_layout, has_bearing_laws, stage_static_displacements
 from ..model import Scenario
 from ..physics import mean_stiffness_N_per_m
 from .build import build_torsional
@@ -112,7 +112,14 @@ def compound_modes(scenario: Scenario) -> ModeSet:
     terms), motor and load free."""
     layout = compound_layout(scenario, modal=True)
     n = len(layout.dof_names)
-    built = build_compound(layout, np.zeros(n), np.zeros(n), sensors=False, modal=True)
+    states = {}  # bearing laws: linearised where they carry the rated load (a clearance is closed there)
+    for link in layout.planetary:
+        if has_bearing_laws(link):
+            st, F = scenario.stages[link.stage], scenario.stage_rated_force_N(link.stage)
+            states[link.stage] = stage_static_displacements(
+                link, link.input_sense * F * st.input_arm_m, -link.output_sense * F * st.output_arm_m
+            )
+    built = build_compound(layout, np.zeros(n), np.zeros(n), sensors=False, modal=True, bearing_states=states)
     freqs, shapes = _eigen(built.mbs)
     masses = np.zeros(n)
     masses[list(layout.rotation_bodies)] = layout.inertias

@@ -69,12 +69,20 @@ def planetary_signals(scenario: Scenario, names: list[str], q, v, a) -> dict[str
         for m, member in enumerate(link.layout.members):
             name = link.names[m]
             ix = names.index(name + "_x")
+            law = member.bearing_law
+            if law is not None:
+                on_member = np.array(
+                    [law.force_N(q[ix : ix + 2, i], v[ix : ix + 2, i]) for i in range(q.shape[1])]
+                ).T
             for d, axis in enumerate("xy"):
                 u, du = q[ix + d], v[ix + d]
                 out[f"{name}_{axis}_m"] = u
                 out[f"{name}_{axis}_velocity_m_s"] = du
                 out[f"{name}_{axis}_accel_m_s2"] = a[ix + d]
-                force = member.bearing_stiffness_N_per_m * u + member.bearing_damping_Ns_per_m * du
+                if law is None:
+                    force = member.bearing_stiffness_N_per_m * u + member.bearing_damping_Ns_per_m * du
+                else:
+                    force = -on_member[d]
                 out[f"{name}_bearing_force_{axis}_N"] = force  # on the housing
         w = {c: v[names.index(link.names[m])] for m, c in enumerate(CENTRAL)}
         out[prefix + "mesh_frequency_hz"] = st.sun.teeth * np.abs(w["sun"] - w["carrier"]) / (2 * math.pi)

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ..physics.planetary import PlanetaryGeometry, PlanetaryGeometryError, PlanetarySpeeds, planetary_speeds
+from .components import Bearing
 from .faults import ErrorMode
 from .params import Node, ScenarioError, param
 
@@ -24,12 +25,33 @@ class PlanetaryMember(Node):
     teeth: int | None = param(None, ge=6, doc="number of teeth z (sun, planet, ring; not the carrier)")
     inertia_kg_m2: float = param(gt=0, doc="polar moment of inertia")
     mass_kg: float = param(gt=0, doc="mass")
-    bearing_stiffness_N_per_m: float = param(gt=0, doc="isotropic bearing stiffness")
-    bearing_damping_Ns_per_m: float = param(0.0, ge=0, doc="isotropic bearing damping")
+    bearing_stiffness_N_per_m: float | None = param(
+        None, gt=0, doc="isotropic linear bearing stiffness (or a bearing law in `bearing`)"
+    )
+    bearing_damping_Ns_per_m: float = param(0.0, ge=0, doc="isotropic linear bearing damping")
+    bearing: Bearing | None = param(
+        None,
+        doc="a registered bearing law instead of bearing_stiffness_N_per_m (a planet's acts in the carrier "
+        "frame on its centre's offset from its pin; docs/planetary.md)",
+    )
     torsion_stiffness_Nm_per_rad: float | None = param(
         None, gt=0, doc="torsional support to the housing (the fixed member only, required there)"
     )
     torsion_damping_Nms_per_rad: float = param(0.0, ge=0, doc="damping of the torsional support")
+
+    def __post_init__(self) -> None:
+        if (self.bearing_stiffness_N_per_m is None) == (self.bearing is None):
+            raise ScenarioError(
+                "bearing_stiffness_N_per_m = "
+                + ("unset" if self.bearing is None else f"{self.bearing_stiffness_N_per_m:g}")
+                + ": give either an isotropic linear bearing (bearing_stiffness_N_per_m > 0 N/m, "
+                "bearing_damping_Ns_per_m) or a bearing law (bearing = { kind, parameters }), not both"
+            )
+        if self.bearing is not None and self.bearing_damping_Ns_per_m:
+            raise ScenarioError(
+                f"bearing_damping_Ns_per_m = {self.bearing_damping_Ns_per_m:g}: with a bearing law the "
+                "damping is the law's (its parameters)"
+            )
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -233,6 +255,11 @@ class PlanetaryStage(Node):
                     f"planet_position_errors_um.{n} = {e:g}: allowed: -{limit_um:g} .. {limit_um:g} um "
                     "(a tenth of the module)"
                 )
+        if self.planet_bearing_defects and self.planet.bearing is not None:
+            raise ScenarioError(
+                "planet_bearing_defects: they weaken the linear planet bearing (bearing_stiffness_N_per_m); "
+                "with a planet bearing law, state the defect in its parameters"
+            )
         planets: dict[int, int] = {}
         for i, d in enumerate(self.planet_bearing_defects, start=1):
             if d.planet > self.planets:

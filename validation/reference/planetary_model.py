@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from .lateral_scenario import bearing_force
 from .mesh import _Mesh
 from .modes import _mesh_force, _mode_error
 
@@ -123,8 +124,10 @@ class PlanetaryStage:
         members = (sun, ring, car) + (pl,) * N
         self.mass = np.array([float(x["mass_kg"]) for x in members])
         self.inertia = np.array([float(x["inertia_kg_m2"]) for x in members])
-        self.kb = [float(x["bearing_stiffness_N_per_m"]) for x in (sun, ring, car, pl)]
+        # a member gives either an isotropic linear bearing or a bearing law (contract "Bearing laws")
+        self.kb = [float(x.get("bearing_stiffness_N_per_m", 0.0)) for x in (sun, ring, car, pl)]
         self.cb = [float(x.get("bearing_damping_Ns_per_m", 0.0)) for x in (sun, ring, car, pl)]
+        self.law = [x.get("bearing") for x in (sun, ring, car, pl)]
         # faults (contract "Faults"): planet bearing factors, pin errors, damaged teeth
         self.bearing_factor = np.ones(N)
         for d in stage.get("planet_bearing_defects", []):
@@ -309,7 +312,12 @@ class PlanetaryStage:
         torsion on the stage's coordinates (no external torques)."""
         Q = np.zeros(self.n_dof)
         cf = 1.0 if damping else 0.0
-        for m in range(3):  # central members on isotropic spring-dampers to the ground
+        for m in range(3):  # central members on isotropic spring-dampers (or their law) to the ground
+            if self.law[m] is not None:
+                Q[3 * m : 3 * m + 2] += bearing_force(
+                    self.law[m], q[3 * m : 3 * m + 2], cf * v[3 * m : 3 * m + 2]
+                )
+                continue
             Q[3 * m : 3 * m + 2] -= self.kb[m] * q[3 * m : 3 * m + 2] + cf * self.cb[m] * v[3 * m : 3 * m + 2]
         f = 3 * self.i_fix + 2
         Q[f] -= self.kt * q[f] + cf * self.ct * v[f]
@@ -320,8 +328,19 @@ class PlanetaryStage:
             b = 9 + 3 * n
             a = tc + self.pin_angle[n]
             ax, ay = self.r_c * math.cos(a), self.r_c * math.sin(a)  # P_n - c_c
-            fx = -kp * (q[b] - xc - ax) - cp * (v[b] - vxc + wc * ay)  # bearing force on the planet
-            fy = -kp * (q[b + 1] - yc - ay) - cp * (v[b + 1] - vyc - wc * ax)
+            if self.law[3] is None:
+                fx = -kp * (q[b] - xc - ax) - cp * (v[b] - vxc + wc * ay)  # bearing force on the planet
+                fy = -kp * (q[b + 1] - yc - ay) - cp * (v[b + 1] - vyc - wc * ax)
+            else:  # the law in the carrier frame: radial along the pin's radius, tangential ahead of it
+                ca, sa = math.cos(a), math.sin(a)
+                ex, ey = q[b] - xc - ax, q[b + 1] - yc - ay
+                dx, dy = v[b] - vxc + wc * ay, v[b + 1] - vyc - wc * ax
+                fr, ft = bearing_force(
+                    self.law[3],
+                    (ca * ex + sa * ey, -sa * ex + ca * ey),
+                    (cf * (ca * dx + sa * dy), cf * (-sa * dx + ca * dy)),
+                )
+                fx, fy = ca * fr - sa * ft, sa * fr + ca * ft
             Q[b] += fx
             Q[b + 1] += fy
             Q[6] -= fx
@@ -384,6 +403,21 @@ class PlanetaryStage:
         # Every mesh is first locked on its loaded flank (contact mode 1: F = k (d - l_u), a law without
         # the backlash's dead zone, whose Jacobian at the unloaded start is regular); once converged the
         # true contact modes take over and Newton goes on until the modes agree with the state.
+        if any(law is not None for law in self.law):
+            # a bearing law with clearance carries nothing at the nominal assembly, where the Jacobian is
+            # singular (the carrier hangs on nothing): Levenberg-Marquardt from there, the meshes locked
+            # on their loaded flanks, then Newton as below
+            from scipy.optimize import least_squares
+
+            def locked_resid(x):
+                qq = q.copy()
+                qq[free] = x
+                return resid(qq, [[nn, k, 1] for nn, k, _ in self.mesh_modes(qq, zero)])
+
+            scale = np.where(free % 3 == 2, 1e-6 / self.r_c, 1e-6)
+            q[free] = least_squares(
+                locked_resid, q[free], method="lm", x_scale=scale, xtol=1e-15, ftol=1e-15, gtol=1e-15
+            ).x
         locked = True
         for _it in range(40):
             modes = self.mesh_modes(q, zero)
