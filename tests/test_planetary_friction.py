@@ -311,3 +311,27 @@ def test_the_stage_loses_what_the_hand_estimate_says():
     assert hand == pytest.approx(0.00483, abs=1e-5)
     measured = loss(MU) - loss(0.0)
     assert measured == pytest.approx(hand, rel=0.03)
+
+
+def test_smoothed_friction_agrees_with_the_reference():
+    """Transition width 0.05 on both meshes (the friction sign's smooth steps at the pitch point and the
+    tooth change), mu = 0.05, 0.01 s: every planet mesh and friction force within 0.5 % of F_rated of the
+    reference's (measured 2.3e-4 %)."""
+    from validation.compare import reference_input
+    from validation.reference.planetary_drive import simulate_reference_drive
+
+    mesh = read_toml(scene_path("planetary"))["design"]["stages"][0]
+    sc = scene(
+        t_end=0.01,
+        sun_mesh={**mesh["sun_mesh"], "transition_width": 0.05},
+        ring_mesh={**mesh["ring_mesh"], "transition_width": 0.05},
+    )
+    res = simulate(sc)
+    ref = simulate_reference_drive(reference_input(sc), t_eval=res.time_s)
+    F_rated = sc.stage_rated_force_N(0)
+    for n in range(1, 4):
+        for kind in ("sun", "ring"):
+            for sig in ("force_N", "friction_force_N"):
+                key = f"planet_{n}_{kind}_mesh_{sig}"
+                assert np.max(np.abs(res[key] - ref[key])) / F_rated < 5e-3, key
+            assert np.ptp(res[f"planet_{n}_{kind}_mesh_friction_force_N"]) > MU * F_rated
