@@ -94,8 +94,9 @@ def test_member_errors_name_the_member():
     d["design"]["stages"][0]["carrier"]["teeth"] = 20
     with pytest.raises(ScenarioError, match="carrier has no teeth"):
         load_scenario(d)
-    with pytest.raises(ScenarioError, match="friction is not modelled in planetary meshes"):
-        load_scenario("planetary", ["condition.friction_coefficient=0.05"])
+    # friction in planetary meshes is modelled (docs/planetary.md, "Friction"): accepted
+    sc = load_scenario("planetary", ["condition.friction_coefficient=0.05"])
+    assert sc.condition.friction_coefficient == 0.05
 
 
 def test_given_angles_on_the_mesh_condition_are_accepted():

@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import InputError
 from ..model import Scenario
 from ..model.planetary import PlanetaryStage
-from ..physics.mesh import I_LU
+from ..physics.mesh import I_LU, I_MU
 from ..physics.planetary_mesh import G_BEARING_K, G_DELTA0_RING, G_DELTA0_SUN, stage_forces
 from .operating_point import static_deflection_m, steady_operating_point
 from .parameters import mesh_parameters_from_scenario, pack_drive_parameters
@@ -145,7 +145,13 @@ def compound_layout(scenario: Scenario, *, modal: bool = False) -> CompoundLayou
         if isinstance(st, PlanetaryStage):
             link = PlanetaryLink(
                 k,
-                layout_from_stage(st, k, scenario.meta.seed, modal=modal),
+                layout_from_stage(
+                    st,
+                    k,
+                    scenario.meta.seed,
+                    modal=modal,
+                    friction_coefficient=0.0 if modal else scenario.condition.friction_coefficient,
+                ),
                 len(names),
                 planetary_member_names(k, st.planets),
                 st.input,
@@ -297,10 +303,11 @@ def stage_static_displacements(
     """Static equilibrium of a planetary stage (displacements from the nominal assembly) under the signed
     external torques on its input and output members and the planets' centrifugal forces m_p w_c^2
     (c_n - c_c) of a carrier turning at ``carrier_speed_rad_s``: exact deflections, the mesh laws at this
-    state without damping; the input rotation held at ``input_angle_rad`` (the gauge); Newton from the
-    nominal assembly (docs/planetary.md, "Initial state")."""
+    state without damping or friction; the input rotation held at ``input_angle_rad`` (the gauge);
+    Newton from the nominal assembly (docs/planetary.md, "Initial state")."""
     ref, G_true = link.reference(), link.geometry_rows()
-    Ps_true, Pr_true = link.layout.mesh_arrays()
+    Ps_true, Pr_true = (P.copy() for P in link.layout.mesh_arrays())
+    Ps_true[..., I_MU] = Pr_true[..., I_MU] = 0.0  # the steady start ignores friction (as for trains)
     # Solved on the loaded flanks: the backlash moved into the assembly deflection (delta - l_u with no
     # clearance is the law's contact branch), so Newton starts from a law without a dead zone; the
     # result is then checked with the true law (every loaded mesh on its flank).

@@ -202,6 +202,7 @@ def layout_from_geometry(
     tooth_factors: tuple | None = None,
     pin_errors_m: tuple[float, ...] = (),
     bearing_factors: tuple[float, ...] = (),
+    friction_coefficient: float = 0.0,
 ) -> PlanetaryLayout:
     """A :class:`PlanetaryLayout` from a checked :class:`gearbody.physics.planetary.PlanetaryGeometry`:
     radii, planet angles, each mesh's contact ratio (:func:`contact_ratios` unless given) and the ring
@@ -210,8 +211,8 @@ def layout_from_geometry(
     error depths are per sun (ring) tooth, None for none. Faults (docs/planetary.md, "Faults"):
     ``tooth_factors`` = (sun factors, ring factors, (planet 1 factors, ..., planet N)) per tooth, the
     planets' in their sun-mesh numbering (each planet then gets its own laws, its ring mesh's wheel
-    factors shifted by M_n + floor(z_p / 2)); pin errors (m) and planet-bearing factors per planet. No
-    friction yet."""
+    factors shifted by M_n + floor(z_p / 2)); pin errors (m) and planet-bearing factors per planet.
+    ``friction_coefficient``: mu of every sun and ring mesh (docs/planetary.md, "Friction")."""
     from ..physics.mesh import pack_mesh_parameters
     from ..physics.planetary import planet_mesh_phases
 
@@ -237,7 +238,7 @@ def layout_from_geometry(
             contact_ratio=eps,
             damping_Ns_per_m=damping_Ns_per_m[k],
             backlash_m=backlash_m[k],
-            friction_coefficient=0.0,
+            friction_coefficient=friction_coefficient,
             pitch_point_phase=pitch_point_phase[k],
             pressure_angle_rad=g.pressure_angle_rad,
             error_a=error_a[k],
@@ -299,11 +300,14 @@ def _member(name: str, m) -> PlanetaryMember:
     )
 
 
-def layout_from_stage(stage, stage_index: int, seed: int, *, modal: bool = False) -> PlanetaryLayout:
+def layout_from_stage(
+    stage, stage_index: int, seed: int, *, modal: bool = False, friction_coefficient: float = 0.0
+) -> PlanetaryLayout:
     """The :class:`PlanetaryLayout` of a scenario's planetary stage (:class:`gearbody.model.planetary.
     PlanetaryStage`, 0-based ``stage_index`` in power-flow order): members, meshes, error modes with the
-    random tooth errors of ``seed`` (docs/planetary.md, "The stage in a drive"). ``modal``: every mesh a
-    constant spring at its mean stiffness (no backlash, errors or damping), for the linearised modes."""
+    random tooth errors of ``seed`` (docs/planetary.md, "The stage in a drive"), friction mu of the
+    scenario's condition. ``modal``: every mesh a constant spring at its mean stiffness (no backlash,
+    errors, damping or friction), for the linearised modes."""
     from ..physics.error_mode import planetary_tooth_error_depths_m
     from ..physics.mesh import mean_stiffness_N_per_m
 
@@ -339,6 +343,7 @@ def layout_from_stage(stage, stage_index: int, seed: int, *, modal: bool = False
         pitch_point_phase=tuple(m.pitch_point_phase for m in meshes),
         error_a=(modes["sun"].a, modes["ring"].a),
         error_depths_m=depths,
+        friction_coefficient=friction_coefficient,
         **_fault_keys(stage),
     )
 

@@ -1,7 +1,8 @@
 """Signals of a drive's planetary stages, from the recorded (resampled) states: every planet's sun- and
-ring-mesh force, K_d, deflection, mesh phase and teeth in mesh; the central members' centre motion and
-bearing forces on the housing; each planet's bearing deflection in the carrier frame (docs/planetary.md,
-"Signals"). Forces come from the compiled law the solver integrated, on the same states."""
+ring-mesh force, friction force, K_d, deflection, mesh phase and teeth in mesh; the central members'
+centre motion and bearing forces on the housing; each planet's bearing deflection in the carrier frame
+(docs/planetary.md, "Signals"). Forces come from the compiled law the solver integrated, on the same
+states."""
 
 from __future__ import annotations
 
@@ -56,10 +57,11 @@ def planetary_signals(scenario: Scenario, names: list[str], q, v, a) -> dict[str
             for mesh, P, col in laws:
                 angle = np.ascontiguousarray(states[:, n, col])
                 delta = np.ascontiguousarray(states[:, n, col + 1])
-                F, _ = mesh_contact_series(angle, delta, np.ascontiguousarray(states[:, n, col + 2]), P)
+                F, T = mesh_contact_series(angle, delta, np.ascontiguousarray(states[:, n, col + 2]), P)
                 p, i, j = mesh_phase_series(angle, P)
                 key = f"{planet}_{mesh}_mesh"
                 out[key + "_force_N"] = F
+                out[key + "_friction_force_N"] = T  # mu |F| s(p), docs/planetary.md "Friction"
                 out[key + "_kd"] = F / link.rated_force_N
                 out[key + "_deflection_m"] = delta
                 out[key + "_phase"] = p

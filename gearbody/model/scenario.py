@@ -318,11 +318,6 @@ def _check_planetary_in_drive(k: int, scenario: Scenario) -> None:
             f"{stage_key(k, 'type')} = 'planetary': only topology 'train' has planetary stages, "
             f"got {scenario.meta.topology!r}"
         )
-    if scenario.condition.friction_coefficient > 0:
-        raise ScenarioError(
-            f"condition.friction_coefficient = {scenario.condition.friction_coefficient:g}: friction is not "
-            "modelled in planetary meshes yet; a drive with a planetary stage needs 0"
-        )
     if scenario.is_lateral:
         raise ScenarioError(
             f"{stage_key(k, 'type')} = 'planetary': parallel stages on lateral bearings are not yet "

@@ -26,6 +26,11 @@ on the line of action.
 
 One flank's geometry is used for both flanks (the back-flank contact of a reversing load uses the same
 line of action), as in the lateral parallel mesh.
+
+Friction (docs/planetary.md, "Friction"): ``T = mu |F| s(p)`` of the mesh law at the contact point, along
+``m = (n_y, -n_x)``; arms from the tangent points, ``rho_1 = r_b1 tan(alpha_w) + (p - pitch) p_b`` for
+the sun or ring, ``rho_p = r_bp tan(alpha_w) -+ (p - pitch) p_b`` for the planet (external: the arms
+share ``R tan(alpha_w)``; internal: they grow together, ``rho_r - rho_p = R tan(alpha_w)``).
 """
 
 from __future__ import annotations
@@ -36,7 +41,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from .mesh import mesh_contact
+from .mesh import I_ARM1, mesh_contact
 
 __all__ = [
     "G_SIZE",
@@ -121,7 +126,8 @@ G_SIZE = 11
 def planet_mesh_states(q: np.ndarray, q_t: np.ndarray, G: np.ndarray):
     """The two meshes of one planet (``q``, ``q_t`` as in :func:`planet_forces`): for the sun mesh and
     then the ring mesh, the mesh law's angle, the deflection from the nominal assembly, its rate and the
-    line of action (n_x, n_y): ``(a_s, d_s, v_s, nx_s, ny_s, a_r, d_r, v_r, nx_r, ny_r)``."""
+    line of action (n_x, n_y), then the two operating pressure angles (rad): ``(a_s, d_s, v_s, nx_s, ny_s,
+    a_r, d_r, v_r, nx_r, ny_r, alpha_s, alpha_r)``."""
     phi_ref = q[8] + G[G_PSI]
     rbs, rbp, rbr = G[G_RB_SUN], G[G_RB_PLANET], G[G_RB_RING]
     pair = np.empty(6)
@@ -130,18 +136,18 @@ def planet_mesh_states(q: np.ndarray, q_t: np.ndarray, G: np.ndarray):
     for k in range(3):
         pair[k], pair[3 + k] = q[k], q[9 + k]
         pair_t[k], pair_t[3 + k] = q_t[k], q_t[9 + k]
-    d, nx_s, ny_s, phi, _ = pair_deflection(pair, rbs, rbp, False, phi_ref)
+    d, nx_s, ny_s, phi, alpha_s = pair_deflection(pair, rbs, rbp, False, phi_ref)
     rate_s = _rate(nx_s, ny_s, pair_t, rbs, rbp, False)
     angle_s, delta_s = q[2] - phi + G[G_ANGLE_SUN], d - G[G_DELTA0_SUN]
     # ring mesh: ring (3..5) and planet
     for k in range(3):
         pair[k], pair_t[k] = q[3 + k], q_t[3 + k]
-    d, nx_r, ny_r, phi, _ = pair_deflection(pair, rbr, rbp, True, phi_ref)
+    d, nx_r, ny_r, phi, alpha_r = pair_deflection(pair, rbr, rbp, True, phi_ref)
     rate_r = _rate(nx_r, ny_r, pair_t, rbr, rbp, True)
     # the ring's angle relative to the line of centres, negated: it grows as the mesh engages (carrier
     # turning counter-clockwise in the ring), so the law's tooth counter and phase run forwards
     angle_r, delta_r = phi - q[5] + G[G_ANGLE_RING], d - G[G_DELTA0_RING]
-    return angle_s, delta_s, rate_s, nx_s, ny_s, angle_r, delta_r, rate_r, nx_r, ny_r
+    return angle_s, delta_s, rate_s, nx_s, ny_s, angle_r, delta_r, rate_r, nx_r, ny_r, alpha_s, alpha_r
 
 
 @njit(cache=True)
@@ -154,26 +160,44 @@ def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarr
     centres (theta_s - phi) and the line of centres' rotation relative to the ring (phi - theta_r), each
     plus ``G[G_ANGLE_*]``: both grow when the sun drives counter-clockwise; forces -F grad(delta). The
     planet bearing is an isotropic spring-damper between the planet centre and its point on the carrier,
-    c_c + r_c (cos, sin)(theta_c + psi), its reaction acting on the carrier at that point. Friction is not
-    modelled here yet."""
+    c_c + r_c (cos, sin)(theta_c + psi), its reaction acting on the carrier at that point. Friction T of
+    each law along m = (n_y, -n_x) (docs/planetary.md, "Friction"): sun mesh, the sun gets -T m and the
+    moment +T rho_s, the planet +T m and +T rho_p; ring mesh, the ring +T m and +T rho_r, the planet -T m
+    and -T rho_p (N, N m). A frictionless law (T = 0) skips it: the same arithmetic as without friction."""
     f = np.zeros(12)
     phi_ref = q[8] + G[G_PSI]
     rbs, rbp, rbr = G[G_RB_SUN], G[G_RB_PLANET], G[G_RB_RING]
-    a_s, d_s, v_s, nx, ny, a_r, d_r, v_r, mx, my = planet_mesh_states(q, q_t, G)
-    F_sun = mesh_contact(a_s, d_s, v_s, P_sun)[0]
+    a_s, d_s, v_s, nx, ny, a_r, d_r, v_r, mx, my, alpha_s, alpha_r = planet_mesh_states(q, q_t, G)
+    F_sun, T, rho, _ = mesh_contact(a_s, d_s, v_s, P_sun)
     f[0] -= F_sun * nx
     f[1] -= F_sun * ny
     f[2] -= F_sun * rbs
     f[9] += F_sun * nx
     f[10] += F_sun * ny
     f[11] -= F_sun * rbp
-    F_ring = mesh_contact(a_r, d_r, v_r, P_ring)[0]
+    if T != 0.0:  # external: rho_s + rho_p = (r_bs + r_bp) tan(alpha_w)
+        dp_pb, ta = rho - P_sun[I_ARM1], math.tan(alpha_s)  # (p - pitch) p_b
+        f[0] -= T * ny
+        f[1] += T * nx
+        f[2] += T * (rbs * ta + dp_pb)
+        f[9] += T * ny
+        f[10] -= T * nx
+        f[11] += T * (rbp * ta - dp_pb)
+    F_ring, T, rho, _ = mesh_contact(a_r, d_r, v_r, P_ring)
     f[3] -= F_ring * mx
     f[4] -= F_ring * my
     f[5] -= F_ring * rbr
     f[9] += F_ring * mx
     f[10] += F_ring * my
     f[11] += F_ring * rbp
+    if T != 0.0:  # internal: rho_r - rho_p = (r_br - r_bp) tan(alpha_w), both grow with the phase
+        dp_pb, ta = rho - P_ring[I_ARM1], math.tan(alpha_r)
+        f[3] += T * my
+        f[4] -= T * mx
+        f[5] += T * (rbr * ta + dp_pb)
+        f[9] -= T * my
+        f[10] += T * mx
+        f[11] -= T * (rbp * ta + dp_pb)
     # planet bearing on the carrier
     rc = G[G_CARRIER_RADIUS]
     c, s = math.cos(phi_ref), math.sin(phi_ref)
@@ -245,7 +269,7 @@ def stage_mesh_series(q: np.ndarray, q_t: np.ndarray, G: np.ndarray) -> np.ndarr
             o = 9 + 3 * k
             for i in range(3):
                 qk[9 + i], qtk[9 + i] = q[m, o + i], q_t[m, o + i]
-            a_s, d_s, v_s, _, _, a_r, d_r, v_r, _, _ = planet_mesh_states(qk, qtk, G[k])
+            a_s, d_s, v_s, _, _, a_r, d_r, v_r, _, _, _, _ = planet_mesh_states(qk, qtk, G[k])
             out[m, k, 0], out[m, k, 1], out[m, k, 2] = a_s, d_s, v_s
             out[m, k, 3], out[m, k, 4], out[m, k, 5] = a_r, d_r, v_r
     return out

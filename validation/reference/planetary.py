@@ -43,7 +43,9 @@ class _PlanetaryBlock:
     def forces(self, q, v, modes, mcs) -> np.ndarray:
         st = self.st
         geo = st.mesh_geometry(q, v)
-        return st.generalised_forces(q, v, geo, st.mesh_forces(geo, mcs, modes))
+        F = st.mesh_forces(geo, mcs, modes)
+        friction = st.friction_forces(geo, mcs, modes, F) if st.mu else None
+        return st.generalised_forces(q, v, geo, F, friction=friction)
 
     def initial_modes(self, q, v) -> list:
         return self.st.mesh_modes(q, v)
@@ -93,6 +95,13 @@ class _PlanetaryBlock:
         geo = st.mesh_geometry(qs, vs)
         F = st.mesh_forces(geo, mcs, modes)
         return [F[kind][n] for n in range(st.N) for kind in ("sun", "ring")]
+
+    def frictions(self, qs, vs, modes, mcs, F_rows) -> list:
+        """Friction forces T (N) of the stage's meshes at states in columns, in mesh order."""
+        st = self.st
+        F = {kind: [F_rows[2 * n + j] for n in range(st.N)] for j, kind in enumerate(("sun", "ring"))}
+        T = st.friction_forces(st.mesh_geometry(qs, vs), mcs, modes, F)[0]
+        return [T[kind][n] for n in range(st.N) for kind in ("sun", "ring")]
 
 
 class _Chain:
@@ -173,15 +182,18 @@ class _Chain:
         return events, actions
 
     def output_buffers(self, n_t: int) -> dict:
-        return {"F": np.full((len(self.meshes), n_t), np.nan)}
+        return {key: np.full((len(self.meshes), n_t), np.nan) for key in ("F", "T")}
 
     def outputs(self, ts, ys, modes, extra, mcs) -> dict:
         nd = self.n_dof
         F = np.empty((len(self.meshes), ts.size))
+        T = np.empty((len(self.meshes), ts.size))
         for b in self.blocks:
-            rows = b.outputs(ys[:nd][b.sl], ys[nd:][b.sl], self._split(modes, b), self._split(mcs, b))
+            qs, vs, md, mc = ys[:nd][b.sl], ys[nd:][b.sl], self._split(modes, b), self._split(mcs, b)
+            rows = b.outputs(qs, vs, md, mc)
             F[b.m0 : b.m0 + len(rows)] = rows
-        return {"F": F}
+            T[b.m0 : b.m0 + len(rows)] = b.frictions(qs, vs, md, mc, rows)
+        return {"F": F, "T": T}
 
     def default_atol(self, rtol: float) -> np.ndarray:
         """rtol times the deflection scale (lengths), over the largest base radius (angles), times the
@@ -202,9 +214,12 @@ def member_names(N: int) -> list[str]:
     return [*MEMBER_NAMES, *(f"planet_{n + 1}" for n in range(N))]
 
 
-def planetary_signals(st: PlanetaryStage, Y: np.ndarray, F: np.ndarray, off: int, prefix: str) -> dict:
+def planetary_signals(
+    st: PlanetaryStage, Y: np.ndarray, F: np.ndarray, off: int, prefix: str, T: np.ndarray | None = None
+) -> dict:
     """Per member ``<prefix><member>_q`` / ``_v`` (n_t x 3: x, y, theta) and per planet
-    ``<prefix>planet_<n>_sun_mesh_force_N``, ``..._ring_mesh_force_N`` and their ``_kd``."""
+    ``<prefix>planet_<n>_sun_mesh_force_N``, ``..._ring_mesh_force_N``, their ``_kd`` and (T given) the
+    friction forces ``..._mesh_friction_force_N``."""
     nd_all = Y.shape[0] // 2
     out = {}
     for m, name in enumerate(member_names(st.N)):
@@ -215,6 +230,8 @@ def planetary_signals(st: PlanetaryStage, Y: np.ndarray, F: np.ndarray, off: int
             key = f"{prefix}planet_{n + 1}_{kind}_mesh_force_N"
             out[key] = F[2 * n + j].copy()
             out[key.replace("_force_N", "_kd")] = F[2 * n + j] / st.F_rated
+            if T is not None:
+                out[key.replace("_force_N", "_friction_force_N")] = T[2 * n + j].copy()
     return out
 
 
@@ -264,7 +281,7 @@ def simulate_reference_planetary_stage(
         "time_s": t_eval,
         "coordinates": Y[: st.n_dof],
         "velocities": Y[st.n_dof :],
-        **planetary_signals(st, Y, F, 0, ""),
+        **planetary_signals(st, Y, F, 0, "", res["out"]["T"]),
         "F_rated_N": np.array(Fr),
         "nfev": np.array(res["nfev"]),
         "n_segments": np.array(res["n_segments"]),

@@ -5,8 +5,10 @@ Coordinates: ``[motor, stage 1, ..., stage N, machine]``; a parallel stage is ``
 (torsional, as in "Gear trains"), a planetary stage its ``3 (N_p + 3)`` member coordinates
 (:mod:`.planetary_model`).  Shafts join chain angles: the motor, a pinion / wheel, ``s_in theta_in`` /
 ``s_out theta_out`` of a planetary stage; the input member receives ``s_in S_in``, the output
-``-s_out S_out`` (the contract's turning-sense rule).  No friction (a planetary drive with
-``condition.friction_coefficient > 0`` is refused; parallel-only trains: :func:`.simulate_reference`).
+``-s_out S_out`` (the contract's turning-sense rule).  Friction ``condition.friction_coefficient`` in
+every mesh: a parallel stage's moments ``-r1 F + T rho_1``, ``r2 F - T rho_2`` (docs/scenario.md),
+the planetary meshes' forces at the contact point (docs/planetary.md, "Friction"); the steady start
+ignores it (parallel-only trains: :func:`.simulate_reference`).
 """
 
 from __future__ import annotations
@@ -16,14 +18,15 @@ import numpy as np
 from .integrate import _contact_edges, _output_times, integrate, phase_events
 from .law import effective_stiffness, total_error
 from .mesh import _Mesh
-from .modes import _mesh_force, _mode_error
+from .modes import _mesh_force, _mode_error, _mode_mu_sign
 from .planetary import _Chain, _PlanetaryBlock, planetary_signals
 from .planetary_model import PlanetaryStage
 from .scenario import design_shafts, profile_value, steady_slip
 
 
 class _ParallelBlock:
-    """A parallel stage ``[pinion, wheel]`` in the chain (torsional, no friction)."""
+    """A parallel stage ``[pinion, wheel]`` in the chain (torsional; friction T = mu |F| s(p) with the
+    arms rho_1 = r1 tan(alpha) + (p - pitch) p_b, rho_2 = r2 tan(alpha) - (p - pitch) p_b)."""
 
     def __init__(self, law: _Mesh, view: dict, off: int, m0: int, inertia: tuple[float, float]):
         self.law, self.view, self.off, self.m0 = law, view, off, m0
@@ -41,9 +44,21 @@ class _ParallelBlock:
         return q[0] * m.cz, m.r1 * q[0] - m.r2 * q[1], m.r1 * v[0] - m.r2 * v[1]
 
     def forces(self, q, v, modes, mcs) -> np.ndarray:
+        m = self.law
         u, delta, ddot = self._kin(q, v)
-        F = _mesh_force(mcs[0], u - modes[0][0], delta, ddot)
-        return np.array([-self.law.r1 * F, self.law.r2 * F])
+        p = u - modes[0][0]
+        F = _mesh_force(mcs[0], p, delta, ddot)
+        if not m.mu:
+            return np.array([-m.r1 * F, m.r2 * F])
+        T = _mode_mu_sign(m, modes[0][1], mcs[0], p) * abs(F)
+        rho1 = m.r1 * m.tan_a + (p - m.ppp) * m.pb
+        rho2 = m.r2 * m.tan_a - (p - m.ppp) * m.pb
+        return np.array([-m.r1 * F + T * rho1, m.r2 * F - T * rho2])
+
+    def frictions(self, qs, vs, modes, mcs, F_rows) -> list:
+        """Friction force T (N) at states in columns."""
+        u = self._kin(qs, vs)[0]
+        return [_mode_mu_sign(self.law, modes[0][1], mcs[0], u - modes[0][0]) * np.abs(F_rows[0])]
 
     def initial_modes(self, q, v) -> list:
         m = self.law
@@ -88,7 +103,7 @@ def _parallel_view(scenario: dict, st: dict, s: int, F_rated: float) -> dict:
         },
         "production": {"error_mode": st["error_mode"], "eccentricity": st.get("eccentricity", [])},
         "condition": {
-            "friction_coefficient": 0.0,
+            "friction_coefficient": float(scenario["condition"].get("friction_coefficient", 0.0)),
             "damaged_teeth": st.get("damaged_teeth", []),
             "pitted_teeth": st.get("pitted_teeth", []),
         },
@@ -123,15 +138,15 @@ def build_drive(scenario: dict):
     shafts = design_shafts(scenario)
     if len(stages) < 1 or len(shafts) != len(stages) + 1:
         raise ValueError(f"a drive of {len(stages)} stages needs {len(stages) + 1} shafts, got {len(shafts)}")
-    if float(scenario["condition"].get("friction_coefficient", 0.0)) != 0.0:
-        raise ValueError("a planetary drive with condition.friction_coefficient > 0 is refused")
     seed = int(scenario["meta"]["seed"])
+    mu = float(scenario["condition"].get("friction_coefficient", 0.0))
     Fr = drive_F_rated(scenario)
     blocks, mass = [], [float(d["motor"]["inertia_kg_m2"])]
     off, m0 = 1, 0
     for s, st in enumerate(stages):
         if st.get("type", "parallel") == "planetary":
-            b = _PlanetaryBlock(PlanetaryStage(st, seed=seed, stage_index=s, F_rated=Fr[s]), off, m0)
+            stage = PlanetaryStage(st, seed=seed, stage_index=s, F_rated=Fr[s], friction_coefficient=mu)
+            b = _PlanetaryBlock(stage, off, m0)
         else:
             view = _parallel_view(scenario, st, s, Fr[s])
             inertia = (float(st["pinion"]["inertia_kg_m2"]), float(st["wheel"]["inertia_kg_m2"]))
@@ -231,16 +246,17 @@ def simulate_reference_drive(
     if atol is None:
         atol = system.default_atol(rtol)
     res = integrate(system, y0, t_eval, rtol, atol, method)
-    Y, F = res["Y"], res["out"]["F"]
+    Y, F, T = res["Y"], res["out"]["F"], res["out"]["T"]
     nd = system.n_dof
     out = {"time_s": t_eval, "coordinates": Y[:nd], "velocities": Y[nd:], "F_rated_N": Fr}
     for s, b in enumerate(blocks):
         prefix = "" if s == 0 else f"stage_{s + 1}_"
-        rows = F[b.m0 : b.m0 + len(b.meshes)]
+        rows, fr = F[b.m0 : b.m0 + len(b.meshes)], T[b.m0 : b.m0 + len(b.meshes)]
         if isinstance(b, _PlanetaryBlock):
-            out.update(planetary_signals(b.st, Y, rows, b.off, prefix))
+            out.update(planetary_signals(b.st, Y, rows, b.off, prefix, fr))
         else:
             out[f"{prefix}mesh_force_N"] = rows[0].copy()
+            out[f"{prefix}friction_force_N"] = fr[0].copy()
             out[f"{prefix}kd"] = rows[0] / Fr[s]
     out["nfev"], out["n_segments"] = np.array(res["nfev"]), np.array(res["n_segments"])
     return out

@@ -1,6 +1,7 @@
 """A planetary stage from the contract (docs/planetary.md, "The stage in a drive: scenario keys and
-equations"), in the inertial frame: geometry and checks, the exact involute deflections and lines of
-action, the bearings and supports, the generalised forces, the rigid speeds and the static equilibrium.
+equations", and "Friction"), in the inertial frame: geometry and checks, the exact involute deflections
+and lines of action, the bearings and supports, the generalised forces (friction as a force at the
+contact point, placed from the tangent points), the rigid speeds and the static equilibrium.
 
 Members are planar rigid bodies ``(x, y, theta)``, ordered sun, ring, carrier, planet 1 .. N (member m
 at coordinates ``3 m .. 3 m + 2``).  The mesh normal force comes from the reference's own locked-mode
@@ -16,7 +17,7 @@ import numpy as np
 
 from .lateral_scenario import bearing_force
 from .mesh import _Mesh
-from .modes import _mesh_force, _mode_error
+from .modes import _mesh_force, _mode_error, _mode_mu_sign
 
 MEMBERS = ("sun", "ring", "carrier")
 SUN, RING, CARRIER = 0, 1, 2
@@ -27,9 +28,11 @@ def involute(a):
     return np.tan(a) - a
 
 
-def _mesh_view(z1, r1, i1, z2, r2, i2, mesh: dict, em: dict, alpha_deg: float, F_rated: float, seed: int):
-    """A one-stage-shaped mesh view of one planetary mesh for :class:`.mesh._Mesh` (no friction, no
-    faults; the random draw is replaced by the caller)."""
+def _mesh_view(
+    z1, r1, i1, z2, r2, i2, mesh: dict, em: dict, alpha_deg: float, F_rated: float, seed: int, mu: float = 0.0
+):
+    """A one-stage-shaped mesh view of one planetary mesh for :class:`.mesh._Mesh` (friction mu gives
+    the law's sign s(p) and its break points; no faults; the random draw is replaced by the caller)."""
     full = {
         "stiffness_profile": mesh.get("stiffness_profile", "contact-ratio"),
         "stiffness_single_N_per_m": float(mesh["stiffness_single_N_per_m"]),
@@ -52,17 +55,27 @@ def _mesh_view(z1, r1, i1, z2, r2, i2, mesh: dict, em: dict, alpha_deg: float, F
             "machine": {"rated_torque_Nm": F_rated * r2},
         },
         "production": {"error_mode": dict(em), "eccentricity": []},
-        "condition": {"friction_coefficient": 0.0, "damaged_teeth": [], "pitted_teeth": []},
+        "condition": {"friction_coefficient": float(mu), "damaged_teeth": [], "pitted_teeth": []},
     }
 
 
 class PlanetaryStage:
     """Constants of one planetary stage (a ``design.stages`` item with ``type = "planetary"``).
 
-    ``F_rated``: the rated force per planet and mesh (scales the tolerances; kd = F / F_rated).
+    ``F_rated``: the rated force per planet and mesh (scales the tolerances; kd = F / F_rated);
+    ``friction_coefficient``: mu of every sun and ring mesh (the drive's condition).
     """
 
-    def __init__(self, stage: dict, *, seed: int = 1, stage_index: int = 0, F_rated: float | None = None):
+    def __init__(
+        self,
+        stage: dict,
+        *,
+        seed: int = 1,
+        stage_index: int = 0,
+        F_rated: float | None = None,
+        friction_coefficient: float = 0.0,
+    ):
+        self.mu = float(friction_coefficient)
         if stage.get("type", "planetary") != "planetary":
             raise ValueError("not a planetary stage")
         self.N = N = int(stage["planets"])
@@ -189,6 +202,7 @@ class PlanetaryStage:
                 math.degrees(alpha),
                 self.F_rated,
                 seed,
+                self.mu,
             )
             view["condition"]["damaged_teeth"] = damaged(factors[kind], wheel_factors)
             law = _Mesh(view, self.F_rated)
@@ -256,8 +270,8 @@ class PlanetaryStage:
         return v
 
     def mesh_geometry(self, q, v):
-        """Per mesh kind ("sun", "ring"): (delta, delta_dot, n_x, n_y, law angle, its rate), arrays over
-        the planets (q, v may carry further axes: states in columns)."""
+        """Per mesh kind ("sun", "ring"): (delta, delta_dot, n_x, n_y, law angle, its rate, alpha_w),
+        arrays over the planets (q, v may carry further axes: states in columns)."""
         xs, ys, ts = q[0], q[1], q[2]
         xr, yr, tr = q[3], q[4], q[5]
         tc = q[8]
@@ -291,7 +305,7 @@ class PlanetaryStage:
                 ddot = self.r_br * va[2] - self.r_bp * wn - (nx * ddx + ny * ddy)
                 ang = phi - ta + 2.0 * math.pi * self.g_ring / self.z_r
                 angdot = phidot - va[2]
-            out[kind] = (delta, ddot, nx, ny, ang, angdot)
+            out[kind] = (delta, ddot, nx, ny, ang, angdot, aw)
         return out
 
     # -- forces -----------------------------------------------------------------------------------------
@@ -299,7 +313,7 @@ class PlanetaryStage:
         """Normal forces (sun, ring) of every planet from the locked modes: F = law(p, delta, delta_dot)."""
         F = {}
         for j, kind in enumerate(("sun", "ring")):
-            delta, ddot, _, _, ang, _ = geo[kind]
+            delta, ddot, ang = geo[kind][0], geo[kind][1], geo[kind][4]
             cz = self.laws[kind].cz  # z1 / 2 pi, the same for every planet
             F[kind] = [
                 _mesh_force(mcs[2 * n + j], ang[n] * cz - modes[2 * n + j][0], delta[n], ddot[n])
@@ -307,9 +321,27 @@ class PlanetaryStage:
             ]
         return F
 
-    def generalised_forces(self, q, v, geo, F, damping: bool = True):
+    def friction_forces(self, geo, mcs, modes, F):
+        """Friction of every planet's meshes (contract "Friction"): per kind, T = mu |F| s(p) over the
+        planets, and the arm offset (p - pitch) p_b (m); p the phase in the mesh's locked mode."""
+        T, dp = {}, {}
+        for j, kind in enumerate(("sun", "ring")):
+            ang = geo[kind][4]
+            T[kind], dp[kind] = [], []
+            for n in range(self.N):
+                law, (nn, k, _) = self.planet_laws[n][kind], modes[2 * n + j]
+                p = ang[n] * law.cz - nn
+                T[kind].append(_mode_mu_sign(law, k, mcs[2 * n + j], p) * np.abs(F[kind][n]))
+                dp[kind].append((p - law.ppp) * law.pb)
+        return T, dp
+
+    def generalised_forces(self, q, v, geo, F, damping: bool = True, friction=None):
         """Generalised forces of meshes (-F grad delta), bearings, supports and the fixed member's
-        torsion on the stage's coordinates (no external torques)."""
+        torsion on the stage's coordinates (no external torques); ``friction`` = (T, arm offsets) of
+        :meth:`friction_forces`: a force along m = n turned -90 deg at the contact point C (sun mesh:
+        C = T_s + rho_s n, T_s = c_s + r_bs m, +T m on the planet; ring mesh: C = T_r - rho_r n, T_r = c_r
+        + r_br m, -T m on the planet; rho_1 = r_b1 tan(alpha_w) + (p - pitch) p_b), the opposite on the
+        sun or ring, each member's moment (C - c) x f."""
         Q = np.zeros(self.n_dof)
         cf = 1.0 if damping else 0.0
         for m in range(3):  # central members on isotropic spring-dampers (or their law) to the ground
@@ -355,6 +387,20 @@ class PlanetaryStage:
                 Q[ia + 1] -= Fn * ny
                 Q[b] += Fn * nx
                 Q[b + 1] += Fn * ny
+                if friction is None:
+                    continue
+                Tn, aw = friction[0][kind][n], geo[kind][6][n]
+                mx, my = ny, -nx
+                rho1 = r1 * math.tan(aw) + friction[1][kind][n]
+                out = sp * rho1  # sun: C = T_s + rho_s n; ring: C = T_r - rho_r n
+                cx, cy = q[ia] + r1 * mx + out * nx, q[ia + 1] + r1 * my + out * ny
+                tx, ty = sp * Tn * mx, sp * Tn * my  # on the planet
+                Q[b] += tx
+                Q[b + 1] += ty
+                Q[b + 2] += (cx - q[b]) * ty - (cy - q[b + 1]) * tx
+                Q[ia] -= tx
+                Q[ia + 1] -= ty
+                Q[ia + 2] -= (cx - q[ia]) * ty - (cy - q[ia + 1]) * tx
         return Q
 
     def mass_vector(self) -> np.ndarray:
@@ -368,7 +414,7 @@ class PlanetaryStage:
         for n in range(self.N):
             for kind in ("sun", "ring"):
                 law = self.planet_laws[n][kind]
-                delta, ddot, _, _, ang, angdot = geo[kind]
+                delta, ddot, ang, angdot = geo[kind][0], geo[kind][1], geo[kind][4], geo[kind][5]
                 nn, k = law.phase_mode(float(ang[n] * law.cz), float(angdot[n] * law.cz))
                 mc = law.mode_consts(nn, k, 0)
                 d = float(delta[n] + _mode_error(mc, ang[n] * law.cz - nn))
