@@ -8,8 +8,8 @@ import pytest
 from gearbody.assembly import mesh_parameters_from_scenario
 from gearbody.model import ScenarioError, load_scenario
 from gearbody.physics.mesh import (
+    contact_force,
     mesh_breakpoint_phases,
-    mesh_contact,
     mesh_error_m,
 )
 
@@ -51,9 +51,9 @@ def test_pits_act_on_their_tooth_and_window_only():
 def test_a_pit_lowers_the_force_by_k_times_depth():
     P = _P('condition.pitted_teeth=[{gear="pinion",tooth=0,depth_um=5.0,start_phase=0.2,end_phase=0.5}]')
     phi = 2 * math.pi * 0.35 / 29  # tooth 0, single contact (h = 0.3)
-    F_pit = mesh_contact(phi, 60e-6, 0.0, P)[0]
-    F_next_rev = mesh_contact(phi + 2 * math.pi, 60e-6, 0.0, P)[0]  # tooth 0 again: the pit recurs
-    F_other = mesh_contact(phi + 2 * math.pi / 29, 60e-6, 0.0, P)[0]  # tooth 1
+    F_pit = contact_force(phi, 60e-6, 0.0, P)[0]
+    F_next_rev = contact_force(phi + 2 * math.pi, 60e-6, 0.0, P)[0]  # tooth 0 again: the pit recurs
+    F_other = contact_force(phi + 2 * math.pi / 29, 60e-6, 0.0, P)[0]  # tooth 1
     assert F_pit == pytest.approx(F_next_rev)
     assert F_other - F_pit == pytest.approx(1.2e9 * 5e-6)
 

@@ -15,10 +15,10 @@ from gearbody.model.resolve import pair_geometry
 from gearbody.model.scenes import scene_path
 from gearbody.physics.mesh import (
     I_HALF_DOUBLE,
+    contact_force,
     effective_stiffness_series,
     mean_stiffness_N_per_m,
     mesh_breakpoint_phases,
-    mesh_contact,
     pack_mesh_parameters,
     stiffness_at_phase,
 )
@@ -121,7 +121,7 @@ def test_energy_pair_and_gear_geometry_agree_on_the_line_of_action():
         P = mesh_parameters_from_scenario(sc, sc.stages.index(st))
         for ph in (0.1, 0.5, 0.9):
             angle = ph * 2 * math.pi / st.pinion.teeth
-            _, _, rho1, rho2 = mesh_contact(angle, 1e-3, 0.0, P)
+            _, _, rho1, rho2 = contact_force(angle, 1e-3, 0.0, P)
             s1, s2 = geo.friction_arms_m(geo.position_on_line_of_action_m(ph))
             assert rho1 == pytest.approx(s1, rel=1e-9)
             assert rho2 == pytest.approx(s2, rel=1e-9)
@@ -177,7 +177,7 @@ def test_pairs_law_sums_the_pairs_in_contact_by_hand():
     # period's pair at q = 0.1 (between -0.25 -> 4 and 0.125 -> 6: 4 + 2 * 0.35/0.375)
     k_hand = (3.6 + 4.0 + 2.0 * 0.35 / 0.375) * 1e8
     assert stiffness_at_phase(0.1, P) == pytest.approx(k_hand, rel=1e-12)
-    F, *_ = mesh_contact(_angle(0, 0.1), 1e-5, 0.0, P)
+    F, *_ = contact_force(_angle(0, 0.1), 1e-5, 0.0, P)
     assert F == pytest.approx(k_hand * 1e-5, rel=1e-12)
     # p = 0.5: the period's pair alone, 8e8; p = 0.9: it (q = 0.9) and the incoming pair (q = -0.1)
     assert stiffness_at_phase(0.5, P) == pytest.approx(8e8)
@@ -213,7 +213,7 @@ def test_damaged_tooth_acts_on_its_pair_over_its_whole_contact():
         )
         assert k == pytest.approx(expected, rel=1e-12), (period, phase)
     # damping factor k / k_healthy: at p = 0.5 of period 2 the damping force is halved too
-    F, *_ = mesh_contact(_angle(2, 0.5), 1e-12, 1.0, P)
+    F, *_ = contact_force(_angle(2, 0.5), 1e-12, 1.0, P)
     assert F == pytest.approx(0.5 * (8e8 * 1e-12 + 100.0), rel=1e-12)
 
 

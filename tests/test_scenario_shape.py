@@ -15,7 +15,10 @@ def test_every_scene_loads_in_both_shapes_to_the_same_scenario(name):
     written = load_scenario(name)  # as shipped: shorthand or [[design.stages]]
     canonical = scenario_to_dict(written)
     assert set(canonical["design"]) == {"motor", "machine", "stages", "shafts"}
-    assert "production" not in canonical and set(canonical["condition"]) == {"friction_coefficient"}
+    assert "production" not in canonical and set(canonical["condition"]) == {
+        "friction_coefficient",
+        "friction_transition_speed_m_s",
+    }
     assert load_scenario(canonical) == written
     assert written.name == name and canonical["meta"]["name"] == name
     assert written.meta.topology in ("train", "two-wheel", "muller")

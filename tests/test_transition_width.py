@@ -11,13 +11,15 @@ import pytest
 from gearbody.engine import simulate
 from gearbody.model import ScenarioError, load_scenario
 from gearbody.physics.mesh import (
-    friction_sign,
+    I_V0,
+    contact_force,
+    friction_force,
     mean_stiffness_N_per_m,
-    mesh_contact,
     mesh_error_m,
     pack_mesh_parameters,
     smooth_step,
     stiffness_at_phase,
+    tooth_change_envelope,
 )
 
 Z1, Z2 = 20, 41
@@ -71,12 +73,17 @@ def test_contact_ratio_ramps():
     )
 
 
-def test_friction_sign_passes_zero_at_the_reversals():
+def test_friction_envelope_passes_zero_at_the_tooth_change_and_the_sliding_sets_the_direction():
     P = _P(0.02, mu=0.1)
-    assert friction_sign(0.0, P) == pytest.approx(0.0, abs=1e-15)
-    assert friction_sign(0.5, P) == pytest.approx(0.0, abs=1e-15)
-    assert friction_sign(0.25, P) == 1.0 and friction_sign(0.75, P) == -1.0
-    assert friction_sign(1 - 1e-12, P) == pytest.approx(0.0, abs=1e-9)
+    assert tooth_change_envelope(0.0, P) == pytest.approx(0.0, abs=1e-15)
+    assert tooth_change_envelope(1 - 1e-12, P) == pytest.approx(0.0, abs=1e-9)
+    assert tooth_change_envelope(0.005, P) == pytest.approx(2 * smooth_step(0.25) - 1, rel=1e-15)
+    for p in (0.01, 0.25, 0.5, 0.75, 0.99):  # 1 outside w/2 of the tooth change (the pitch point too)
+        assert tooth_change_envelope(p, P) == 1.0
+    assert tooth_change_envelope(0.0, _P(0.0, mu=0.1)) == 1.0  # sharp law: no envelope
+    v0 = P[I_V0]
+    assert friction_force(5.0, 2 * v0, P) == -5.0 and friction_force(5.0, -2 * v0, P) == 5.0
+    assert friction_force(5.0, 0.0, P) == 0.0
 
 
 def test_tooth_factor_blends_across_the_tooth_change():
@@ -85,12 +92,12 @@ def test_tooth_factor_blends_across_the_tooth_change():
     P = _P(0.02, factors=f)
     k_double = 1.5e9
     d = 1e-6
-    F_at_change = mesh_contact(_angle(3, 0.0), d, 0.0, P)[0]
+    F_at_change = contact_force(_angle(3, 0.0), d, 0.0, P)[0]
     assert F_at_change == pytest.approx(0.75 * k_double * d, rel=1e-9)
-    assert mesh_contact(_angle(3, 0.01), d, 0.0, P)[0] == pytest.approx(0.5 * k_double * d, rel=1e-9)
-    assert mesh_contact(_angle(2, 0.99), d, 0.0, P)[0] == pytest.approx(k_double * d, rel=1e-9)
+    assert contact_force(_angle(3, 0.01), d, 0.0, P)[0] == pytest.approx(0.5 * k_double * d, rel=1e-9)
+    assert contact_force(_angle(2, 0.99), d, 0.0, P)[0] == pytest.approx(k_double * d, rel=1e-9)
     # continuous from the outgoing side: just before the change equals just after
-    before = mesh_contact(_angle(3, 0.0) - 1e-12, d, 0.0, P)[0]
+    before = contact_force(_angle(3, 0.0) - 1e-12, d, 0.0, P)[0]
     assert before == pytest.approx(F_at_change, rel=1e-6)
 
 

@@ -151,6 +151,7 @@ def compound_layout(scenario: Scenario, *, modal: bool = False) -> CompoundLayou
                     scenario.meta.seed,
                     modal=modal,
                     friction_coefficient=0.0 if modal else scenario.condition.friction_coefficient,
+                    friction_transition_speed_m_s=scenario.condition.friction_transition_speed_m_s,
                 ),
                 len(names),
                 planetary_member_names(k, st.planets),

@@ -58,6 +58,7 @@ def mesh_parameters_from_scenario(scenario: Scenario, stage: int = 0, *, frictio
         transition_width=mesh.transition_width,
         pair_stiffness_N_per_m=None if pair_table is None else pair_table.stiffness_N_per_m,
         pair_ratios=None if pair_table is None else pair_table.ratios,
+        friction_transition_speed_m_s=scenario.condition.friction_transition_speed_m_s,
     )
 
 

@@ -203,6 +203,7 @@ def layout_from_geometry(
     pin_errors_m: tuple[float, ...] = (),
     bearing_factors: tuple[float, ...] = (),
     friction_coefficient: float = 0.0,
+    friction_transition_speed_m_s: float = 1e-3,
 ) -> PlanetaryLayout:
     """A :class:`PlanetaryLayout` from a checked :class:`gearbody.physics.planetary.PlanetaryGeometry`:
     radii, planet angles, each mesh's contact ratio (:func:`contact_ratios` unless given) and the ring
@@ -212,7 +213,8 @@ def layout_from_geometry(
     ``tooth_factors`` = (sun factors, ring factors, (planet 1 factors, ..., planet N)) per tooth, the
     planets' in their sun-mesh numbering (each planet then gets its own laws, its ring mesh's wheel
     factors shifted by M_n + floor(z_p / 2)); pin errors (m) and planet-bearing factors per planet.
-    ``friction_coefficient``: mu of every sun and ring mesh (docs/planetary.md, "Friction")."""
+    ``friction_coefficient``, ``friction_transition_speed_m_s``: mu and v_0 of every sun and ring mesh
+    (docs/planetary.md, "Friction")."""
     from ..physics.mesh import pack_mesh_parameters
     from ..physics.planetary import planet_mesh_phases
 
@@ -239,6 +241,7 @@ def layout_from_geometry(
             damping_Ns_per_m=damping_Ns_per_m[k],
             backlash_m=backlash_m[k],
             friction_coefficient=friction_coefficient,
+            friction_transition_speed_m_s=friction_transition_speed_m_s,
             pitch_point_phase=pitch_point_phase[k],
             pressure_angle_rad=g.pressure_angle_rad,
             error_a=error_a[k],
@@ -301,12 +304,18 @@ def _member(name: str, m) -> PlanetaryMember:
 
 
 def layout_from_stage(
-    stage, stage_index: int, seed: int, *, modal: bool = False, friction_coefficient: float = 0.0
+    stage,
+    stage_index: int,
+    seed: int,
+    *,
+    modal: bool = False,
+    friction_coefficient: float = 0.0,
+    friction_transition_speed_m_s: float = 1e-3,
 ) -> PlanetaryLayout:
     """The :class:`PlanetaryLayout` of a scenario's planetary stage (:class:`gearbody.model.planetary.
     PlanetaryStage`, 0-based ``stage_index`` in power-flow order): members, meshes, error modes with the
-    random tooth errors of ``seed`` (docs/planetary.md, "The stage in a drive"), friction mu of the
-    scenario's condition. ``modal``: every mesh a constant spring at its mean stiffness (no backlash,
+    random tooth errors of ``seed`` (docs/planetary.md, "The stage in a drive"), friction mu and v_0 of
+    the scenario's condition. ``modal``: every mesh a constant spring at its mean stiffness (no backlash,
     errors, damping or friction), for the linearised modes."""
     from ..physics.error_mode import planetary_tooth_error_depths_m
     from ..physics.mesh import mean_stiffness_N_per_m
@@ -344,6 +353,7 @@ def layout_from_stage(
         error_a=(modes["sun"].a, modes["ring"].a),
         error_depths_m=depths,
         friction_coefficient=friction_coefficient,
+        friction_transition_speed_m_s=friction_transition_speed_m_s,
         **_fault_keys(stage),
     )
 

@@ -46,7 +46,7 @@ from ..model import Scenario
 from ..physics import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
 from ..physics.lateral import tangent_stiffness_N_per_m
-from ..physics.mesh import mesh_contact, single_mesh_drive_forces, torsional_mesh_forces
+from ..physics.mesh import contact_force, single_mesh_drive_forces, torsional_mesh_forces
 from .user_functions import (
     StallWatchdog,
     bearing_user_function,
@@ -313,7 +313,7 @@ def build_muller(scenario: Scenario, q0, v0, *, sensors: bool = True) -> BuiltSy
     D = pack_drive_parameters(scenario)
     F_rated = scenario.rated_mesh_force_N
     watchdog = built.watchdog
-    contact = compiled(mesh_contact, 0.0, 0.0, 0.0, P)
+    contact = compiled(contact_force, 0.0, 0.0, 0.0, P)
     angle = compiled(synchronous_angle_at, 0.0, D)
     load = compiled(load_fraction_at, 0.0, D)
 

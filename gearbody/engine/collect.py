@@ -207,12 +207,21 @@ def _drive_torques(scenario, t, motor_speed_rad_s) -> dict[str, np.ndarray]:
     }
 
 
-def _mesh_signals(pinion_angle, delta, delta_rate, P, rated_force_N: float) -> dict[str, np.ndarray]:
-    F, T = mesh_contact_series(
-        np.ascontiguousarray(pinion_angle), np.ascontiguousarray(delta), np.ascontiguousarray(delta_rate), P
+def _mesh_signals(
+    pinion_angle, delta, delta_rate, rated_force_N: float, P, speeds=None, centre_sliding=None
+) -> dict[str, np.ndarray]:
+    """Stage signals from the law the solver integrated. ``speeds`` = (pinion, wheel) rotation speeds
+    (rad/s) and ``centre_sliding`` = (u_p' - u_w') . m (m/s) give the sliding velocity that sets the
+    friction's direction; without them (Muller: no friction) both are taken as 0."""
+    zero = np.zeros(len(pinion_angle))
+    w_p, w_w = speeds if speeds is not None else (zero, zero)
+    F, T, v_sl = mesh_contact_series(
+        *(np.ascontiguousarray(x, dtype=float) for x in (pinion_angle, delta, delta_rate, w_p, w_w)),
+        np.ascontiguousarray(zero if centre_sliding is None else centre_sliding, dtype=float),
+        P,
     )
     p, i, j = mesh_phase_series(np.ascontiguousarray(pinion_angle), P)
-    return {
+    out = {
         "mesh_force_N": F,
         "kd": F / rated_force_N,
         "friction_force_N": T,
@@ -221,6 +230,9 @@ def _mesh_signals(pinion_angle, delta, delta_rate, P, rated_force_N: float) -> d
         "pinion_tooth": i,
         "wheel_tooth": j,
     }
+    if speeds is not None:
+        out["sliding_velocity_m_s"] = v_sl  # friction opposes it: T v_sl <= 0 (docs/scenario.md, "Friction")
+    return out
 
 
 def _torsional_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> dict[str, np.ndarray]:
@@ -241,13 +253,15 @@ def _torsional_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> di
         r1, r2 = st.pinion.base_radius_m, st.wheel.base_radius_m
         P = mesh_parameters_from_scenario(scenario, k)
         delta, rate = r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw]
-        n, _, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
+        n, m, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
+        sliding = np.zeros(len(t))
         for name, sign in ((pname, 1.0), (wname, -1.0)):
             if f"{name}_x" in names:
                 ix, iy = names.index(f"{name}_x"), names.index(f"{name}_y")
                 delta = delta + sign * (q[ix] * n[0] + q[iy] * n[1])
                 rate = rate + sign * (v[ix] * n[0] + v[iy] * n[1])
-        sig = _mesh_signals(q[ip], delta, rate, P, scenario.stage_rated_force_N(k))
+                sliding = sliding + sign * (v[ix] * m[0] + v[iy] * m[1])
+        sig = _mesh_signals(q[ip], delta, rate, scenario.stage_rated_force_N(k), P, (v[ip], v[iw]), sliding)
         sig["mesh_frequency_hz"] = st.pinion.teeth * v[ip] / (2 * math.pi)
         prefix = "" if k == 0 else f"stage_{k + 1}_"
         out.update({prefix + key: value for key, value in sig.items()})
@@ -297,7 +311,7 @@ def _muller_signals(scenario, t, x, xd, xdd) -> dict[str, np.ndarray]:
         "pinion_angle_rad": theta,
     }
     P = mesh_parameters_from_scenario(scenario, friction=False)
-    out.update(_mesh_signals(theta, x, xd, P, scenario.rated_mesh_force_N))
+    out.update(_mesh_signals(theta, x, xd, scenario.rated_mesh_force_N, P))
     out["load_torque_Nm"] = np.array([load_torque_at(tk, D) for tk in t])
     out["mesh_frequency_hz"] = np.gradient(theta, t) * scenario.stages[0].pinion.teeth / (2 * math.pi)
     return out

@@ -15,8 +15,8 @@ from ..assembly.compound import PlanetaryLink, compound_layout
 from ..assembly.planetary_layout import CENTRAL
 from ..model import Scenario
 from ..model.planetary import PlanetaryStage
-from ..physics.mesh import mesh_contact_series, mesh_phase_series
-from ..physics.planetary_mesh import stage_mesh_series
+from ..physics.mesh import mesh_phase_series
+from ..physics.planetary_mesh import stage_contact_series, stage_mesh_series
 from .sampling import mesh_jump_times
 
 __all__ = ["planetary_jump_times", "planetary_signals", "stage_input_name"]
@@ -35,13 +35,13 @@ def _links(scenario: Scenario) -> tuple[PlanetaryLink, ...]:
     return compound_layout(scenario).planetary
 
 
-def _stage_states(link: PlanetaryLink, names: list[str], q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """(n_t, N, 6) mesh states of a stage on recorded displacements q, v (n_coordinates x n_t)."""
+def _stage_coordinates(link: PlanetaryLink, names: list[str], q: np.ndarray, v: np.ndarray):
+    """A stage's absolute coordinates and their rates (n_t x (9 + 3 N)) on recorded displacements q, v
+    (n_coordinates x n_t), and its planets' geometry rows."""
     first = names.index(link.names[0] + "_x")
     rows = slice(first, first + link.size)
     absolute = np.ascontiguousarray((q[rows] + link.reference()[:, None]).T)
-    rate = np.ascontiguousarray(v[rows].T)
-    return stage_mesh_series(absolute, rate, link.geometry_rows())
+    return absolute, np.ascontiguousarray(v[rows].T), link.geometry_rows()
 
 
 def planetary_signals(scenario: Scenario, names: list[str], q, v, a) -> dict[str, np.ndarray]:
@@ -50,18 +50,21 @@ def planetary_signals(scenario: Scenario, names: list[str], q, v, a) -> dict[str
     for link in _links(scenario):
         k, st = link.stage, scenario.stages[link.stage]
         prefix = "" if k == 0 else f"stage_{k + 1}_"
-        states = _stage_states(link, names, q, v)
+        absolute, rate, G = _stage_coordinates(link, names, q, v)
+        states = stage_mesh_series(absolute, rate, G)  # law angle, deflection, rate per mesh
+        contacts = stage_contact_series(absolute, rate, G, *link.layout.mesh_arrays())  # F, T, v_T
         for n in range(st.planets):
             planet = f"{prefix}planet_{n + 1}"
             laws = (("sun", link.layout.sun_mesh_of(n), 0), ("ring", link.layout.ring_mesh_of(n), 3))
             for mesh, P, col in laws:
                 angle = np.ascontiguousarray(states[:, n, col])
                 delta = np.ascontiguousarray(states[:, n, col + 1])
-                F, T = mesh_contact_series(angle, delta, np.ascontiguousarray(states[:, n, col + 2]), P)
+                F, T, v_T = (contacts[:, n, col + c] for c in range(3))
                 p, i, j = mesh_phase_series(angle, P)
                 key = f"{planet}_{mesh}_mesh"
                 out[key + "_force_N"] = F
-                out[key + "_friction_force_N"] = T  # mu |F| s(p), docs/planetary.md "Friction"
+                out[key + "_friction_force_N"] = T  # opposes v_T: docs/planetary.md "Friction"
+                out[key + "_sliding_velocity_m_s"] = v_T  # T v_T <= 0 is the friction power
                 out[key + "_kd"] = F / link.rated_force_N
                 out[key + "_deflection_m"] = delta
                 out[key + "_phase"] = p
@@ -127,7 +130,7 @@ def _planet_bearing(link: PlanetaryLink, names, q, n: int, planet: str) -> dict[
 def planetary_jump_times(scenario: Scenario, k: int, names, t_s: np.ndarray, q, v) -> list[np.ndarray]:
     """Times where stage k's mesh laws jump (every planet's two meshes), for band-limited sampling."""
     link = next(link for link in _links(scenario) if link.stage == k)
-    states = _stage_states(link, names, q, v)
+    states = stage_mesh_series(*_stage_coordinates(link, names, q, v))
     out = []
     for n in range(len(link.layout.planet_angles_rad)):
         for P, col in ((link.layout.sun_mesh_of(n), 0), (link.layout.ring_mesh_of(n), 3)):

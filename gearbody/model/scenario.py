@@ -105,6 +105,13 @@ class Design(Node):
 @dataclass(frozen=True, kw_only=True)
 class Condition(Node):
     friction_coefficient: float = param(0.0, ge=0, lt=1, doc="inter-tooth friction mu (every mesh)")
+    friction_transition_speed_m_s: float = param(
+        1e-3,
+        ge=1e-6,
+        le=1.0,
+        doc="sliding speed v_0 below which the friction force's direction blends smoothly through 0 "
+        "(T = -mu |F| sigma(v_sl / v_0), docs/scenario.md 'Friction')",
+    )
 
 
 SOLVER_METHODS = ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")

@@ -35,7 +35,7 @@ SHAFT_KEYS = {("design", "coupling"): 0, ("design", "output_shaft"): 1}
 LEGACY_SCENES = {"one-stage": "train", "train": "train", "two-wheel": "two-wheel", "muller": "muller"}
 CANONICAL_KEYS = {
     "design": ("motor", "machine", "stages", "shafts"),
-    "condition": ("friction_coefficient",),
+    "condition": ("friction_coefficient", "friction_transition_speed_m_s"),
     "production": (),
 }
 

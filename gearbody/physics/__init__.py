@@ -3,7 +3,9 @@
 from . import _numba_cache  # noqa: F401  (first: drops stale compiled kernels before any is loaded)
 from .error_mode import tooth_error_depths_m, tooth_random_factors
 from .mesh import (
+    contact_force,
     error_shape,
+    friction_force,
     mean_stiffness_N_per_m,
     mesh_contact,
     mesh_contact_series,
@@ -25,7 +27,9 @@ from .motor import (
 from .profiles import profile_arrays, profile_integral, profile_value
 
 __all__ = [
+    "contact_force",
     "error_shape",
+    "friction_force",
     "kloss_torque_Nm",
     "load_fraction_at",
     "load_torque_at",

@@ -5,7 +5,8 @@ mesh force the pinion exerts on the wheel), ``m = s1 z x n`` the friction direct
 pinion's rotation sense. The deflection includes the centre displacements projected on the line of
 action, ``delta = r1 phi_p - r2 phi_w + (u_p - u_w) . n``; the pinion receives ``-F n + T m`` and the
 moment ``-r1 F + T rho_1``, the wheel ``+F n - T m`` and ``r2 F - T rho_2`` (action and reaction; the
-paper's eqs. (7) and (9) print the same sign on both gears).
+paper's eqs. (7) and (9) print the same sign on both gears). T opposes the sliding velocity
+``rho_1 phi_p' - rho_2 phi_w' + (u_p' - u_w') . m`` (free directions only), so ``T v_sl <= 0``.
 """
 
 from __future__ import annotations
@@ -49,7 +50,13 @@ def lateral_mesh_forces(q, q_t, idx, geometry, P):
     if idx[4] >= 0:
         delta -= q[idx[4]] * nx + q[idx[5]] * ny
         rate -= q_t[idx[4]] * nx + q_t[idx[5]] * ny
-    F, T, rho1, rho2 = mesh_contact(q[ip], delta, rate, P)
+    # sliding of the pinion's flank point relative to the wheel's along m (the power of a unit T)
+    sliding = 0.0
+    if idx[1] >= 0:
+        sliding += q_t[idx[1]] * mx * geometry[4] + q_t[idx[2]] * my * geometry[5]
+    if idx[4] >= 0:
+        sliding -= q_t[idx[4]] * mx * geometry[6] + q_t[idx[5]] * my * geometry[7]
+    F, T, rho1, rho2, _ = mesh_contact(q[ip], delta, rate, q_t[ip], q_t[iw], sliding, P)
     out = np.zeros(q.size)
     out[ip] = -r1 * F + T * rho1
     out[iw] = r2 * F - T * rho2

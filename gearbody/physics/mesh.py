@@ -8,7 +8,9 @@ reported are exactly the ones integrated. All parameters travel in one float64 a
 Conventions (docs/scenario.md): mesh phase ``p = frac(phi_p z1 / 2 pi)`` from the computed pinion angle;
 pinion tooth ``i = n mod z1`` and wheel tooth ``j = n mod z2`` with ``n = floor(phi_p z1 / 2 pi)``;
 ``d = delta + E(p)``, ``F_el = k (max(d - l_u, min(d + l_u, 0)))``; damping only in contact;
-friction ``T = mu |F| s(p)`` reversing at the pitch point, arms ``rho_1, rho_2`` along the line of action.
+friction ``T = -mu |F| e(p) sigma(v_sl / v_0)`` opposing the flanks' sliding velocity ``v_sl`` at the
+contact point (in forward motoring it reverses at the pitch point, the paper's law), arms ``rho_1, rho_2``
+along the line of action, ``sigma`` the regularised sign :func:`smooth_sign` over ``|v_sl| < v_0``.
 The error ``E`` is the tooth error mode plus two production/condition faults: a once-per-revolution
 run-out of either gear, ``A sin(phi + theta)`` along the line of action (wheel angle taken as
 ``phi_p z1 / z2``), and a pit on a tooth flank, ``-depth`` while that tooth's pair is between two mesh
@@ -16,8 +18,9 @@ phases (material missing: the pair deflects less).
 
 Regularisation (``transition_width`` w, a fraction of the mesh period; 0 = the sharp law of the paper):
 every jump of the law at fixed deflection, i.e. the single/double contact switches of k_z, the change of
-tooth pair at p = 0 (stiffness factors, errors), the pit edges and the friction reversals (pitch point and
-tooth change), is spread over ``|p - p_jump| < w / 2`` by the C2 smooth step :func:`smooth_step`.
+tooth pair at p = 0 (stiffness factors, errors), the pit edges and the friction at the tooth change (where
+the arms jump: the envelope ``e(p)``), is spread over ``|p - p_jump| < w / 2`` by the C2 smooth step
+:func:`smooth_step`.
 Across the tooth change the factor and the error are blended between the outgoing and incoming pairs
 (each evaluated with its own phase, p + 1 or p - 1). Each ramp is antisymmetric about its centre, so the
 mean stiffness over a period is unchanged. docs/scenario.md, "Transition width".
@@ -44,6 +47,7 @@ I_NTAB = 16
 I_ECC_P, I_ECC_P_PHASE, I_ECC_W, I_ECC_W_PHASE = 17, 18, 19, 20  # run-out amplitudes (m), phases (rad)
 I_WIDTH = 21  # transition width w, fraction of the mesh period (0: sharp law)
 I_PAIR_N = 22  # points N of the pair stiffness table ("pairs" profile), 0 otherwise
+I_V0 = 23  # friction transition speed v_0 (m/s): the direction blends through 0 over |v_sl| < v_0
 I_HEADER = 24
 # after the header: e_i (z1), pinion factors (z1), wheel factors (z2), table phases (n), table k (n),
 # pit depth / start phase / end phase per pinion tooth (3 z1), then per wheel tooth (3 z2);
@@ -80,6 +84,7 @@ def pack_mesh_parameters(
     transition_width: float = 0.0,
     pair_stiffness_N_per_m: np.ndarray | None = None,
     pair_ratios: dict[tuple[str, int], np.ndarray] | None = None,
+    friction_transition_speed_m_s: float = 1e-3,
 ) -> np.ndarray:
     """Pack everything the mesh law needs into one float64 array (see module docstring).
 
@@ -133,6 +138,7 @@ def pack_mesh_parameters(
     head[I_ECC_P], head[I_ECC_W] = runout_m
     head[I_ECC_P_PHASE], head[I_ECC_W_PHASE] = runout_phase_rad
     head[I_WIDTH] = transition_width
+    head[I_V0] = friction_transition_speed_m_s
     return np.concatenate([head, e, f, g, tp, tk, pits_p.T.ravel(), pits_w.T.ravel(), *pairs])
 
 
@@ -145,6 +151,12 @@ def smooth_step(x: float) -> float:
         return 1.0
     u = x + 0.5
     return u * u * u * (10.0 + u * (6.0 * u - 15.0))
+
+
+@njit(cache=True)
+def smooth_sign(x: float) -> float:
+    """Regularised sign: -1 for x <= -1, +1 for x >= 1, ``2 S(x / 2) - 1`` in between (C2, odd, 0 at 0)."""
+    return 2.0 * smooth_step(0.5 * x) - 1.0
 
 
 @njit(cache=True)
@@ -351,8 +363,9 @@ def effective_stiffness_series(pinion_angle_rad: np.ndarray, P: np.ndarray) -> n
 
 
 @njit(cache=True)
-def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float, P: np.ndarray):
-    """Normal mesh force F (N, elastic + damping), friction force T (N) and arms rho_1, rho_2 (m).
+def contact_force(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float, P: np.ndarray):
+    """Normal mesh force F (N, elastic + damping), the friction force's magnitude ``mu |F| e(p)`` (N, its
+    direction comes from the sliding: :func:`friction_force`) and the arms rho_1, rho_2 (m).
 
     ``pinion_angle_rad`` sets the mesh phase and the teeth in mesh; ``delta_m`` is the deflection
     along the line of action (r1 phi_p - r2 phi_w, plus centre motions in lateral models).
@@ -367,28 +380,55 @@ def mesh_contact(pinion_angle_rad: float, delta_m: float, delta_rate_m_s: float,
         F = k * (d + lu) + P[I_CZ] * factor * delta_rate_m_s
     else:
         F = 0.0
-    T = P[I_MU] * abs(F) * friction_sign(p, P)  # |F|: dissipative on the back flank too
+    friction_N = P[I_MU] * abs(F) * tooth_change_envelope(p, P)  # |F|: the back flank slides too
     dp = p - P[I_PITCH]
     rho1 = P[I_ARM1] + dp * P[I_PB]
     rho2 = P[I_ARM2] - dp * P[I_PB]
-    return F, T, rho1, rho2
+    return F, friction_N, rho1, rho2
 
 
 @njit(cache=True)
-def friction_sign(p: float, P: np.ndarray) -> float:
-    """Direction of the friction force at mesh phase p: +1 before the pitch point, -1 after; with a
-    transition width, smooth steps at the pitch point and at the tooth change (0 there)."""
-    pitch, w = P[I_PITCH], P[I_WIDTH]
-    if w > 0.0 and 0.0 < pitch < 1.0:
-        return 2.0 * (smooth_step(p / w) - smooth_step((p - pitch) / w) + smooth_step((p - 1.0) / w)) - 1.0
-    return 1.0 if p < pitch else -1.0
+def friction_force(friction_N: float, sliding_velocity_m_s: float, P: np.ndarray) -> float:
+    """Signed friction force T (N) of magnitude ``friction_N`` opposing ``sliding_velocity_m_s``, the
+    velocity whose product with T is the friction power (``T v <= 0``): ``-friction_N sigma(v / v_0)``."""
+    if friction_N == 0.0:
+        return 0.0
+    return -(friction_N * smooth_sign(sliding_velocity_m_s / P[I_V0]))
+
+
+@njit(cache=True)
+def mesh_contact(
+    pinion_angle_rad: float,
+    delta_m: float,
+    delta_rate_m_s: float,
+    pinion_speed_rad_s: float,
+    wheel_speed_rad_s: float,
+    centre_sliding_m_s: float,
+    P: np.ndarray,
+):
+    """Normal mesh force F (N), friction force T (N), arms rho_1, rho_2 (m) and the sliding velocity
+    ``v_sl = rho_1 w_p - rho_2 w_w + centre_sliding`` (m/s) of a parallel mesh; ``centre_sliding_m_s`` is
+    ``(u_p' - u_w') . m`` of lateral gears (0 for torsional ones). T opposes v_sl: ``T v_sl <= 0``."""
+    F, friction_N, rho1, rho2 = contact_force(pinion_angle_rad, delta_m, delta_rate_m_s, P)
+    v_sl = rho1 * pinion_speed_rad_s - rho2 * wheel_speed_rad_s + centre_sliding_m_s
+    return F, friction_force(friction_N, v_sl, P), rho1, rho2, v_sl
+
+
+@njit(cache=True)
+def tooth_change_envelope(p: float, P: np.ndarray) -> float:
+    """Friction's envelope e(p): with a transition width w, ``(2 S(p/w) - 1)(1 - 2 S((p - 1)/w))``, 0 at the
+    tooth change where the arms jump (so T rho stays continuous); 1 elsewhere and when w = 0."""
+    w = P[I_WIDTH]
+    if w > 0.0:
+        return (2.0 * smooth_step(p / w) - 1.0) * (1.0 - 2.0 * smooth_step((p - 1.0) / w))
+    return 1.0
 
 
 @njit(cache=True)
 def torsional_mesh_forces(phi_p: float, phi_w: float, w_p: float, w_w: float, P: np.ndarray):
     """Generalised mesh moments on pinion and wheel (N m), eq. (1): -r1 F + T rho_1, r2 F - T rho_2."""
     r1, r2 = P[I_R1], P[I_R2]
-    F, T, rho1, rho2 = mesh_contact(phi_p, r1 * phi_p - r2 * phi_w, r1 * w_p - r2 * w_w, P)
+    F, T, rho1, rho2, _ = mesh_contact(phi_p, r1 * phi_p - r2 * phi_w, r1 * w_p - r2 * w_w, w_p, w_w, 0.0, P)
     return -r1 * F + T * rho1, r2 * F - T * rho2
 
 
@@ -404,15 +444,30 @@ def single_mesh_drive_forces(
 
 @njit(cache=True)
 def mesh_contact_series(
-    pinion_angle_rad: np.ndarray, delta_m: np.ndarray, delta_rate_m_s: np.ndarray, P: np.ndarray
+    pinion_angle_rad: np.ndarray,
+    delta_m: np.ndarray,
+    delta_rate_m_s: np.ndarray,
+    pinion_speed_rad_s: np.ndarray,
+    wheel_speed_rad_s: np.ndarray,
+    centre_sliding_m_s: np.ndarray,
+    P: np.ndarray,
 ):
-    """:func:`mesh_contact` over arrays: returns (F, T) in N."""
+    """:func:`mesh_contact` over arrays: returns F (N), T (N) and the sliding velocity v_sl (m/s)."""
     nt = pinion_angle_rad.size
     F = np.empty(nt)
     T = np.empty(nt)
+    v = np.empty(nt)
     for m in range(nt):
-        F[m], T[m], _, _ = mesh_contact(pinion_angle_rad[m], delta_m[m], delta_rate_m_s[m], P)
-    return F, T
+        F[m], T[m], _, _, v[m] = mesh_contact(
+            pinion_angle_rad[m],
+            delta_m[m],
+            delta_rate_m_s[m],
+            pinion_speed_rad_s[m],
+            wheel_speed_rad_s[m],
+            centre_sliding_m_s[m],
+            P,
+        )
+    return F, T, v
 
 
 @njit(cache=True)
@@ -443,15 +498,15 @@ def mesh_gap_series(pinion_angle_rad: np.ndarray, delta_m: np.ndarray, P: np.nda
 
 def mesh_breakpoint_phases(P: np.ndarray) -> np.ndarray:
     """Mesh phases in [0, 1) where the force law jumps at fixed deflection: the tooth change (p = 0,
-    per-tooth stiffness factors), the single/double contact switches, the friction reversal, pit edges.
+    per-tooth stiffness factors, the friction arms), the single/double contact switches and pit edges. (The
+    friction direction follows the sliding velocity, blended over ``|v_sl| < v_0``: no jump at the pitch
+    point.)
     None with a non-zero transition width: the law is then continuous in the phase."""
     if P[I_WIDTH] > 0.0:
         return np.zeros(0)
     phases = [0.0]
     if P[I_KIND] != PROFILE_TABLE and 0.0 < P[I_HALF_DOUBLE] < 0.5:
         phases += [P[I_HALF_DOUBLE], 1.0 - P[I_HALF_DOUBLE]]
-    if P[I_MU] != 0.0:
-        phases.append(P[I_PITCH] % 1.0)
     z1, z2 = int(P[I_Z1]), int(P[I_Z2])
     o = I_HEADER + 2 * z1 + z2 + 2 * int(P[I_NTAB])
     for offset, teeth in ((o, z1), (o + 3 * z1, z2)):

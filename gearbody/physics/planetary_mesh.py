@@ -27,10 +27,11 @@ on the line of action.
 One flank's geometry is used for both flanks (the back-flank contact of a reversing load uses the same
 line of action), as in the lateral parallel mesh.
 
-Friction (docs/planetary.md, "Friction"): ``T = mu |F| s(p)`` of the mesh law at the contact point, along
-``m = (n_y, -n_x)``; arms from the tangent points, ``rho_1 = r_b1 tan(alpha_w) + (p - pitch) p_b`` for
-the sun or ring, ``rho_p = r_bp tan(alpha_w) -+ (p - pitch) p_b`` for the planet (external: the arms
-share ``R tan(alpha_w)``; internal: they grow together, ``rho_r - rho_p = R tan(alpha_w)``).
+Friction (docs/planetary.md, "Friction"): ``|T| = mu |F| e(p)`` of the mesh law at the contact point,
+along ``m = (n_y, -n_x)``, opposing the flanks' sliding ``v_T`` (the power of a unit T, so ``T v_T <= 0``);
+arms from the tangent points, ``rho_1 = r_b1 tan(alpha_w) + (p - pitch) p_b`` for the sun or ring,
+``rho_p = r_bp tan(alpha_w) -+ (p - pitch) p_b`` for the planet (external: the arms share ``R
+tan(alpha_w)``; internal: they grow together, ``rho_r - rho_p = R tan(alpha_w)``).
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from .mesh import I_ARM1, mesh_contact
+from .mesh import I_ARM1, contact_force, friction_force
 
 __all__ = [
     "G_SIZE",
@@ -50,7 +51,9 @@ __all__ = [
     "pair_deflection",
     "pair_deflection_rate",
     "planet_forces",
+    "planet_mesh_contacts",
     "planet_mesh_states",
+    "stage_contact_series",
     "stage_mesh_series",
     "stage_forces",
 ]
@@ -151,53 +154,81 @@ def planet_mesh_states(q: np.ndarray, q_t: np.ndarray, G: np.ndarray):
 
 
 @njit(cache=True)
+def planet_mesh_contacts(
+    q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarray, P_ring: np.ndarray, sliding: bool
+):
+    """The contact of one planet's two meshes (``q``, ``q_t`` as in :func:`planet_forces`): for the sun
+    mesh and then the ring mesh, the normal force F (N), the friction force T (N), the sliding velocity
+    v_T (m/s, the power of a unit T: ``P_f = T v_T <= 0``), the arms of member 1 and of the planet (m) and
+    the line of action (n_x, n_y). Friction follows docs/planetary.md, "Friction": sun mesh ``v_T = (c_n' -
+    c_s') . m + w_s rho_s + w_p rho_p``, ring mesh ``v_T = (c_r' - c_n') . m + w_r rho_r - w_p rho_p``.
+    Without friction (mu = 0) the arms and v_T are computed only when ``sliding`` asks for them (else 0)."""
+    a_s, d_s, r_s, nx, ny, a_r, d_r, r_r, mx, my, alpha_s, alpha_r = planet_mesh_states(q, q_t, G)
+    rbs, rbp, rbr = G[G_RB_SUN], G[G_RB_PLANET], G[G_RB_RING]
+    F_s, fr, rho, _ = contact_force(a_s, d_s, r_s, P_sun)
+    T_s = v_s = rho_s = rho_ps = 0.0
+    if fr != 0.0 or sliding:  # external: rho_s + rho_p = (r_bs + r_bp) tan(alpha_w)
+        dp_pb, ta = rho - P_sun[I_ARM1], math.tan(alpha_s)  # (p - pitch) p_b
+        rho_s, rho_ps = rbs * ta + dp_pb, rbp * ta - dp_pb
+        v_s = -q_t[0] * ny + q_t[1] * nx + q_t[2] * rho_s + q_t[9] * ny - q_t[10] * nx + q_t[11] * rho_ps
+        T_s = friction_force(fr, v_s, P_sun)
+    F_r, fr, rho, _ = contact_force(a_r, d_r, r_r, P_ring)
+    T_r = v_r = rho_r = rho_pr = 0.0
+    if fr != 0.0 or sliding:  # internal: rho_r - rho_p = (r_br - r_bp) tan(alpha_w), both grow with the phase
+        dp_pb, ta = rho - P_ring[I_ARM1], math.tan(alpha_r)
+        rho_r, rho_pr = rbr * ta + dp_pb, rbp * ta + dp_pb
+        v_r = q_t[3] * my - q_t[4] * mx + q_t[5] * rho_r - q_t[9] * my + q_t[10] * mx - q_t[11] * rho_pr
+        T_r = friction_force(fr, v_r, P_ring)
+    return F_s, T_s, v_s, rho_s, rho_ps, nx, ny, F_r, T_r, v_r, rho_r, rho_pr, mx, my
+
+
+@njit(cache=True)
 def planet_forces(q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarray, P_ring: np.ndarray):
     """Generalised forces (12) of one planet's sun mesh, ring mesh and bearing on the carrier, and the two
     normal mesh forces (N). ``q``, ``q_t``: absolute [x, y, theta] of sun, ring, carrier, planet (m, rad).
-    The meshes are :func:`gearbody.physics.mesh.mesh_contact` on the exact deflection of
+    The meshes are :func:`gearbody.physics.mesh.contact_force` on the exact deflection of
     :func:`pair_deflection` (sun mesh: sun = member 1, z1 = z_sun in ``P_sun``; ring mesh: ring = member
     1, z1 = z_ring in ``P_ring``), the law's angle being the sun's rotation relative to the line of
     centres (theta_s - phi) and the line of centres' rotation relative to the ring (phi - theta_r), each
     plus ``G[G_ANGLE_*]``: both grow when the sun drives counter-clockwise; forces -F grad(delta). The
     planet bearing is an isotropic spring-damper between the planet centre and its point on the carrier,
     c_c + r_c (cos, sin)(theta_c + psi), its reaction acting on the carrier at that point. Friction T of
-    each law along m = (n_y, -n_x) (docs/planetary.md, "Friction"): sun mesh, the sun gets -T m and the
-    moment +T rho_s, the planet +T m and +T rho_p; ring mesh, the ring +T m and +T rho_r, the planet -T m
-    and -T rho_p (N, N m). A frictionless law (T = 0) skips it: the same arithmetic as without friction."""
+    each law along m = (n_y, -n_x) (docs/planetary.md, "Friction", :func:`planet_mesh_contacts`): sun mesh,
+    the sun gets -T m and the moment +T rho_s, the planet +T m and +T rho_p; ring mesh, the ring +T m and
+    +T rho_r, the planet -T m and -T rho_p (N, N m). A frictionless law (T = 0) skips it: the same
+    arithmetic as without friction."""
     f = np.zeros(12)
     phi_ref = q[8] + G[G_PSI]
     rbs, rbp, rbr = G[G_RB_SUN], G[G_RB_PLANET], G[G_RB_RING]
-    a_s, d_s, v_s, nx, ny, a_r, d_r, v_r, mx, my, alpha_s, alpha_r = planet_mesh_states(q, q_t, G)
-    F_sun, T, rho, _ = mesh_contact(a_s, d_s, v_s, P_sun)
+    F_sun, T, _, rho_s, rho_p, nx, ny, F_ring, T_r, _, rho_r, rho_pr, mx, my = planet_mesh_contacts(
+        q, q_t, G, P_sun, P_ring, False
+    )
     f[0] -= F_sun * nx
     f[1] -= F_sun * ny
     f[2] -= F_sun * rbs
     f[9] += F_sun * nx
     f[10] += F_sun * ny
     f[11] -= F_sun * rbp
-    if T != 0.0:  # external: rho_s + rho_p = (r_bs + r_bp) tan(alpha_w)
-        dp_pb, ta = rho - P_sun[I_ARM1], math.tan(alpha_s)  # (p - pitch) p_b
+    if T != 0.0:
         f[0] -= T * ny
         f[1] += T * nx
-        f[2] += T * (rbs * ta + dp_pb)
+        f[2] += T * rho_s
         f[9] += T * ny
         f[10] -= T * nx
-        f[11] += T * (rbp * ta - dp_pb)
-    F_ring, T, rho, _ = mesh_contact(a_r, d_r, v_r, P_ring)
+        f[11] += T * rho_p
     f[3] -= F_ring * mx
     f[4] -= F_ring * my
     f[5] -= F_ring * rbr
     f[9] += F_ring * mx
     f[10] += F_ring * my
     f[11] += F_ring * rbp
-    if T != 0.0:  # internal: rho_r - rho_p = (r_br - r_bp) tan(alpha_w), both grow with the phase
-        dp_pb, ta = rho - P_ring[I_ARM1], math.tan(alpha_r)
-        f[3] += T * my
-        f[4] -= T * mx
-        f[5] += T * (rbr * ta + dp_pb)
-        f[9] -= T * my
-        f[10] += T * mx
-        f[11] -= T * (rbp * ta + dp_pb)
+    if T_r != 0.0:
+        f[3] += T_r * my
+        f[4] -= T_r * mx
+        f[5] += T_r * rho_r
+        f[9] -= T_r * my
+        f[10] += T_r * mx
+        f[11] -= T_r * rho_pr
     # planet bearing on the carrier
     rc = G[G_CARRIER_RADIUS]
     c, s = math.cos(phi_ref), math.sin(phi_ref)
@@ -272,4 +303,30 @@ def stage_mesh_series(q: np.ndarray, q_t: np.ndarray, G: np.ndarray) -> np.ndarr
             a_s, d_s, v_s, _, _, a_r, d_r, v_r, _, _, _, _ = planet_mesh_states(qk, qtk, G[k])
             out[m, k, 0], out[m, k, 1], out[m, k, 2] = a_s, d_s, v_s
             out[m, k, 3], out[m, k, 4], out[m, k, 5] = a_r, d_r, v_r
+    return out
+
+
+@njit(cache=True)
+def stage_contact_series(
+    q: np.ndarray, q_t: np.ndarray, G: np.ndarray, P_sun: np.ndarray, P_ring: np.ndarray
+) -> np.ndarray:
+    """The contacts of every planet over samples (``q``, ``q_t`` n_t x (9 + 3 N) as in
+    :func:`stage_mesh_series`, laws as in :func:`stage_forces`): (n_t, N, 6) with F, T, v_T of the sun mesh,
+    then of the ring mesh (N, N, m/s; :func:`planet_mesh_contacts`), exactly what the solver integrated."""
+    nt, n = q.shape[0], G.shape[0]
+    Ps, Pr = _law_rows(P_sun), _law_rows(P_ring)
+    ns, nr = Ps.shape[0], Pr.shape[0]
+    out = np.empty((nt, n, 6))
+    qk = np.empty(12)
+    qtk = np.empty(12)
+    for m in range(nt):
+        for i in range(9):
+            qk[i], qtk[i] = q[m, i], q_t[m, i]
+        for k in range(n):
+            o = 9 + 3 * k
+            for i in range(3):
+                qk[9 + i], qtk[9 + i] = q[m, o + i], q_t[m, o + i]
+            c = planet_mesh_contacts(qk, qtk, G[k], Ps[k % ns], Pr[k % nr], True)
+            out[m, k, 0], out[m, k, 1], out[m, k, 2] = c[0], c[1], c[2]
+            out[m, k, 3], out[m, k, 4], out[m, k, 5] = c[7], c[8], c[9]
     return out
