@@ -169,7 +169,7 @@ class Result:
         from .analysis import separation_stats
 
         if self.planetary_stages:
-            return self._planetary_summary()
+            return {**self._planetary_summary(), **self._direction_summary()}
         win = self.final_window()
         sep = separation_stats(self.mesh_force, self.time_s, kd=self.kd)
         speed = (
@@ -211,6 +211,28 @@ class Result:
                 for gear in self.bearing_gears
                 for axis in "xy"
             },
+            **self._direction_summary(),
+        }
+
+    def rotation_directions(self):
+        """Which way each rotation turned (:class:`gearbody.analysis.RotationDirections`): its smallest
+        speed in its driven direction and, if it turned backwards, since when (an overrunning load)."""
+        from .analysis import rotation_directions
+
+        nominal = self.meta.get("nominal_speeds_rad_s") or {}
+        speeds = {name: self[f"{name}_speed_rad_s"] for name in nominal if f"{name}_speed_rad_s" in self}
+        return rotation_directions(self.time_s, speeds, nominal)
+
+    def _direction_summary(self) -> dict[str, Any]:
+        """summary() keys of :meth:`rotation_directions`: ``<rotation>_driven_speed_min_rad_s`` and
+        ``turned_backwards`` with the first rotation and time (NaN and '' when it never did)."""
+        d = self.rotation_directions()
+        first = d.first
+        return {
+            **{f"{name}_driven_speed_min_rad_s": v for name, v in d.driven_speed_min_rad_s.items()},
+            "turned_backwards": d.turned_backwards,
+            "turned_backwards_first": first[0] if first else "",
+            "turned_backwards_at_s": first[1] if first else float("nan"),
         }
 
     @property
@@ -273,7 +295,10 @@ class Result:
                 out[f"{prefix}{mesh}_mesh_kd_max_final"] = float(kd[:, win].max())
                 out[f"{prefix}{mesh}_mesh_kd_min"] = float(kd.min())
                 out[f"{prefix}{mesh}_mesh_kd_mean_final"] = float(means.mean())
-                out[f"{prefix}{mesh}_mesh_load_sharing_factor"] = float(means.max() / means.mean())
+                mean = means.mean()  # no load: no sharing to speak of (NaN)
+                out[f"{prefix}{mesh}_mesh_load_sharing_factor"] = (
+                    float(means.max() / mean) if mean != 0.0 else float("nan")
+                )
                 out[f"{prefix}{mesh}_mesh_separation_fraction"] = float(
                     max(s.separated_fraction for s in seps)
                 )

@@ -37,6 +37,7 @@ from gearbody.analysis.planet_pass import (
 )
 from gearbody.analysis.planetary_lines import PlanetaryLine, PlanetarySources, planetary_lines
 from gearbody.analysis.psd import Psd, power_spectral_density
+from gearbody.analysis.rotation import RotationDirections, rotation_directions
 from gearbody.analysis.spectrum import (
     Peak,
     SidebandLine,
@@ -62,6 +63,8 @@ __all__ = [
     "KinematicSources",
     "LabelledPeak",
     "Psd",
+    "RotationDirections",
+    "rotation_directions",
     "Shaft",
     "kinematic_lines",
     "label_peaks",

@@ -347,7 +347,8 @@ def stage_static_displacements(
     if lay.planet.bearing_law is not None:  # the planets' weak spring acts on their pins (the carrier)
         G_soft[:, G_BEARING_K] += REGULARISING_N_PER_M
     G_free = G
-    scale = max(abs(input_torque_Nm), abs(output_torque_Nm), 1.0)
+    # the residual's scale: the torques, or with no load the planets' centrifugal forces
+    scale = max(abs(input_torque_Nm), abs(output_torque_Nm), w2 * link.layout.carrier_radius_m, 1.0)
     # Newton with a central-difference Jacobian (the laws are piecewise linear in the deflections, the
     # geometry smooth): steps of 1e-9 m on centres and 1e-9 m / r_c on rotations
     steps = np.array([1e-9 if i % 3 < 2 else 1e-9 / link.layout.carrier_radius_m for i in free])
@@ -365,7 +366,10 @@ def stage_static_displacements(
                 e = np.zeros(free.size)
                 e[j] = h
                 J[:, j] = (residual(x + e) - residual(x - e)) / (2 * h)
-            dx = np.linalg.solve(J, r)
+            try:
+                dx = np.linalg.solve(J, r)
+            except np.linalg.LinAlgError:  # a member free in the backlash (no load): any equilibrium will do
+                dx = np.linalg.lstsq(J, r, rcond=None)[0]
             longest = np.max(np.abs(dx / steps)) * 1e-9  # in m (rotations times r_c)
             x = x - dx * min(1.0, max_step_m / longest)
             r = residual(x)

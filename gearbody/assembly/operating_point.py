@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..model import Scenario
+from ..model.planetary import PlanetaryStage
 from ..physics.lateral import mesh_directions, static_bearing_displacement_m
 from ..physics.mesh import effective_stiffness_series, pair_in_mesh
 from ..physics.motor import steady_slip
@@ -139,3 +140,31 @@ def initial_state(scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
 def mesh_frequency_hz(scenario: Scenario, pinion_speed_rad_s: float) -> float:
     """Mesh frequency f_z = z1 w / (2 pi)."""
     return scenario.stages[0].pinion.teeth * pinion_speed_rad_s / (2 * math.pi)
+
+
+def nominal_speeds_rad_s(scenario: Scenario) -> dict[str, float]:
+    """Each rotation coordinate's speed when the motor turns at its synchronous speed and nothing
+    deflects (rad/s, in the coordinate's own sense): positive for the motor, the gears of parallel stages
+    and the machine (their driven directions); a planetary member's absolute counter-clockwise speed from
+    Willis's relation (its sign says which way that member is driven; a fixed member's is 0).
+    Muller's model has no rotation coordinates."""
+    if scenario.meta.topology == "muller":
+        return {}
+    w = scenario.design.motor.synchronous_speed_rad_s
+    out = {"motor": w} if scenario.meta.topology == "train" else {}
+    for k, st in enumerate(scenario.stages):
+        if isinstance(st, PlanetaryStage):
+            prefix = "" if k == 0 else f"stage_{k + 1}_"
+            willis = st.speeds(w)
+            for member in ("sun", "ring", "carrier"):
+                out[prefix + member] = st.input_sense * willis.of(member)
+            for n in range(st.planets):
+                out[f"{prefix}planet_{n + 1}"] = st.input_sense * willis.planet_rad_s
+        else:
+            pname, wname = gear_names(k)
+            out[pname] = w
+            out[wname] = w * st.input_arm_m / st.output_arm_m
+        w = w * st.input_arm_m / st.output_arm_m
+    if scenario.meta.topology == "train":
+        out["machine"] = w
+    return out

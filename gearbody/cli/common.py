@@ -185,3 +185,11 @@ def check_options(args: argparse.Namespace) -> None:
         if isinstance(value, OutOfRange):
             option = "--" + dest.replace("_", "-")
             raise InputError(f"{option} = {value.text}: must be {value.allowed}")
+
+
+def warn_if_backwards(result) -> None:
+    """One line on stderr when a rotation of the run turned against its driven direction (an overrunning
+    load is never silent; the summary carries the details: ``turned_backwards*``, ``*_driven_speed_min``)."""
+    line = result.rotation_directions().message()
+    if line:
+        print(f"gearbody: warning: {line}", file=sys.stderr)

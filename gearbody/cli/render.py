@@ -19,6 +19,7 @@ from .common import (
     scenario_labels,
     scenario_overrides,
     usage_error,
+    warn_if_backwards,
 )
 
 MAX_FRAMES = 2000  # gearbody.render.MAX_FRAMES (not imported here: the renderer loads on use)
@@ -175,6 +176,7 @@ def execute(args) -> int:
             if not args.quiet:
                 print(f"simulating {args.scene} ({scenario.operation.t_end_s:g} s) ...")
             result = simulate(scenario, progress=not args.quiet)
+            warn_if_backwards(result)
         if args.result is None and not args.kinematic and not args.interactive:
             from gearbody.model import dump_scenario
 

@@ -17,6 +17,7 @@ from .common import (
     number,
     scenario_labels,
     scenario_overrides,
+    warn_if_backwards,
 )
 
 
@@ -79,6 +80,7 @@ def execute(args) -> int:
     summary = result.summary()
     summary["wall_time_s"] = time.perf_counter() - t0
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    warn_if_backwards(result)
     plots = [] if args.no_plots else result.plot(out)
     if args.report:
         from gearbody.reports.html import write_report

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..analysis.antialias import band_limited_samples
 from ..assembly import gear_names, mesh_parameters_from_scenario, pack_drive_parameters
+from ..assembly.operating_point import nominal_speeds_rad_s
 from ..errors import SimulationError
 from ..model import Scenario, budget, scenario_to_dict
 from ..model.params import stage_key
@@ -99,6 +100,7 @@ def collect(scenario: Scenario, built: BuiltSystem) -> Result:
         **_first_stage_teeth(scenario.stages[0]),
         "stages": [_stage_meta(scenario, k) for k in range(len(scenario.stages))],
         "sources": list(scenario.meta.sources),
+        "nominal_speeds_rad_s": nominal_speeds_rad_s(scenario),
         "solver_statistics": stats,
     }
     return Result(time_s=t, signals=signals, meta=meta)
