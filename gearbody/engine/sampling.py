@@ -2,7 +2,7 @@
 
 The force law is continuous in the state except where the mesh phase passes a breakpoint of
 :func:`~gearbody.physics.mesh.mesh_breakpoint_phases` (tooth change, single/double contact switch,
-friction reversal) and where contact starts or ends (damping switches on with the deflection rate).
+pit edges) and where contact starts or ends (damping switches on with the deflection rate).
 Both are located on the fine output grid by linear interpolation of smooth functions of time
 (``u = z1 phi_p / 2 pi - p_break`` crossing an integer, ``d -+ l_u`` crossing zero).
 """

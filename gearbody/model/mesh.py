@@ -109,7 +109,7 @@ class Mesh(Node):
         ge=0,
         le=0.1,
         doc="fraction of the mesh period over which each jump of the law (k_z switches, tooth change, "
-        "friction reversal, pit edges) is spread; 0 = sharp",
+        "friction at the tooth change, pit edges) is spread; 0 = sharp",
     )
 
     def __post_init__(self) -> None:
