@@ -13,6 +13,7 @@ positive in their driven direction; a planetary input (output) member turns with
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -396,19 +397,46 @@ def stage_static_displacements(
     return q
 
 
+START_SHIFTS = (0.0, 0.01, -0.01, 0.03, -0.03, 0.1)
+"""Start angles of the drive tried by the steady start, in tooth pitches of the first stage's input: a
+planetary stage's static state can straddle a jump of a mesh stiffness (Newton then cycles between its
+two sides), and a start a little further on is as good a steady state."""
+
+
 def compound_initial_state(scenario: Scenario, layout: CompoundLayout) -> tuple[np.ndarray, np.ndarray]:
     """Initial coordinates and velocities (docs/planetary.md, "Initial state"): all zero from rest;
     'steady': rigid speeds, each stage at static equilibrium under its share of the initial load, the
-    chain's angles stage by stage in power-flow order as for trains."""
+    chain's angles stage by stage in power-flow order as for trains, the first stage's input at angle 0
+    (or, where a static state straddles a stiffness jump, turned by a :data:`START_SHIFTS` fraction of its
+    tooth pitch)."""
+    n = len(layout.dof_names)
+    if scenario.operation.initial_state == "rest":
+        return np.zeros(n), np.zeros(n)
+    first = scenario.stages[0]
+    pitch_rad = (
+        2 * math.pi / (first.pinion.teeth if not isinstance(first, PlanetaryStage) else _input_teeth(first))
+    )
+    for shift in START_SHIFTS:
+        try:
+            return _steady_state(scenario, layout, shift * pitch_rad)
+        except InputError as exc:
+            if "no static equilibrium" not in str(exc) or shift == START_SHIFTS[-1]:
+                raise
+
+
+def _input_teeth(stage: PlanetaryStage) -> int:
+    """Teeth that set the mesh period along the input member's angle (the carrier: the ring's)."""
+    return stage.sun.teeth if stage.input == "sun" else stage.ring.teeth
+
+
+def _steady_state(scenario: Scenario, layout: CompoundLayout, start_angle_rad: float):
     n = len(layout.dof_names)
     q, v = np.zeros(n), np.zeros(n)
-    if scenario.operation.initial_state == "rest":
-        return q, v
     op = steady_operating_point(scenario)
     links = {link.stage: link for link in layout.planetary}
     meshes = {m.stage: m for m in layout.meshes}
     shafts = scenario.design.shafts
-    angle_in = 0.0  # the stage input's angle in the chain's driven direction (first stage: 0)
+    angle_in = start_angle_rad  # the stage input's angle in the chain's driven direction
     for k, st in enumerate(scenario.stages):
         force, w_in = op["mesh_force_N"][k], op["pinion_speed_rad_s"][k]
         T_in = force * st.input_arm_m
