@@ -9,6 +9,10 @@ from dataclasses import dataclass
 from ..physics.bearings import BEARINGS, make_bearing
 from .params import Node, ScenarioError, param
 
+MAX_TEETH = 2000
+"""Largest tooth count of any gear (it sizes the per-tooth arrays of the mesh laws; large ring gears
+have a few hundred)."""
+
 
 @dataclass(frozen=True, kw_only=True)
 class Motor(Node):
@@ -67,7 +71,7 @@ LATERAL = ("none", "y", "xy")
 
 @dataclass(frozen=True, kw_only=True)
 class Gear(Node):
-    teeth: int = param(ge=6, doc="number of teeth z")
+    teeth: int = param(ge=6, le=MAX_TEETH, doc="number of teeth z")
     base_radius_m: float | None = param(
         None, gt=0, doc="base radius r_b (required unless the mesh has a [geometry] table)"
     )

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ..physics.planetary import PlanetaryGeometry, PlanetaryGeometryError, PlanetarySpeeds, planetary_speeds
-from .components import Bearing
+from .components import MAX_TEETH, Bearing
 from .faults import ErrorMode
 from .params import Node, ScenarioError, param
 
@@ -22,7 +22,9 @@ class PlanetaryMember(Node):
     """A member of a planetary stage: teeth (not the carrier), mass, inertia, its bearing (the planet's:
     on the carrier; the others': to the housing) and, for the fixed member, its torsional support."""
 
-    teeth: int | None = param(None, ge=6, doc="number of teeth z (sun, planet, ring; not the carrier)")
+    teeth: int | None = param(
+        None, ge=6, le=MAX_TEETH, doc="number of teeth z (sun, planet, ring; not the carrier)"
+    )
     inertia_kg_m2: float = param(gt=0, doc="polar moment of inertia")
     mass_kg: float = param(gt=0, doc="mass")
     bearing_stiffness_N_per_m: float | None = param(
