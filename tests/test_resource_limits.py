@@ -45,7 +45,7 @@ def test_an_output_rate_beyond_the_budget_is_refused_with_its_estimate():
     """On main solver.output_rate_hz=1e10 was killed by the system at 24 GB with no message."""
     msg = refused("one-stage", "solver.output_rate_hz=1e10")
     assert "solver.output_rate_hz = 1e+10 with operation.t_end_s = 2" in msg
-    assert "2e+10 output samples x 23 signals" in msg and "2048" in msg
+    assert "2e+10 output samples x 24 signals" in msg and "2048" in msg
 
 
 def test_a_huge_end_time_is_refused_on_the_command_line_with_exit_2(tmp_path, capsys):

@@ -68,7 +68,7 @@ def coordinates(scenario: Scenario) -> int:
 
 
 def signal_count(scenario: Scenario) -> int:
-    """Signals of the result: 3 per rotation, 9 per mesh, 2 drive torques, 3 per free direction and 4
+    """Signals of the result: 3 per rotation, 10 per mesh, 2 drive torques, 3 per free direction and 4
     bearing and housing signals per lateral gear (13 for Muller's model)."""
     if scenario.meta.topology == "muller":
         return 13
@@ -76,7 +76,7 @@ def signal_count(scenario: Scenario) -> int:
     rotations = coordinates(scenario) - sum(len(g.free_directions) for g in gears)
     lateral = sum(3 * len(g.free_directions) + 4 for g in gears if g.lateral != "none")
     meshes = len(gears) // 2 + sum(2 * st.planets for st in scenario.stages if hasattr(st, "planets"))
-    return 3 * rotations + 9 * meshes + 2 + lateral
+    return 3 * rotations + 10 * meshes + 2 + lateral
 
 
 def is_band_limited(scenario: Scenario) -> bool:
