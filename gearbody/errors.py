@@ -24,6 +24,12 @@ class ScenarioError(InputError):
     """Invalid scenario input; the message names file, key, value and allowed range."""
 
 
+class StageError(InputError, LookupError):
+    """A stage that does not exist, or a question that does not apply to the stage's kind (the pinion of
+    a planetary stage, the planets of a parallel one); the message names the stage and what applies
+    (exit code 2)."""
+
+
 class SimulationError(GearbodyError, RuntimeError):
     """Numerical failure of a run (exit code 3): the message names the simulated time and a hint."""
 
@@ -64,6 +70,7 @@ __all__ = [
     "RenderError",
     "ScenarioError",
     "SimulationError",
+    "StageError",
     "StudyError",
     "StudySpecError",
 ]
