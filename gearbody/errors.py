@@ -30,6 +30,13 @@ class StageError(InputError, LookupError):
     (exit code 2)."""
 
 
+class SignalError(InputError, KeyError):
+    """A signal a result does not hold; the message names it and the signals there are (a KeyError, so
+    mapping-style lookups keep working; exit code 2)."""
+
+    __str__ = Exception.__str__  # the message as given, not KeyError's quoted repr
+
+
 class SimulationError(GearbodyError, RuntimeError):
     """Numerical failure of a run (exit code 3): the message names the simulated time and a hint."""
 
@@ -69,6 +76,7 @@ __all__ = [
     "ReferenceMismatch",
     "RenderError",
     "ScenarioError",
+    "SignalError",
     "SimulationError",
     "StageError",
     "StudyError",

@@ -16,7 +16,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .errors import StageError
+from .errors import SignalError, StageError
 
 FINAL_FRACTION = 0.25
 """Share of the run, at its end, over which 'final' values are taken (the steady period)."""
@@ -49,7 +49,7 @@ class Result:
         try:
             return self.signals[name]
         except KeyError:
-            raise KeyError(f"no signal {name!r}; signals: {', '.join(sorted(self.signals))}") from None
+            raise SignalError(f"no signal {name!r}; signals: {', '.join(sorted(self.signals))}") from None
 
     def __contains__(self, name: str) -> bool:
         return name == "time_s" or name in self.signals

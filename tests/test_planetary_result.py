@@ -27,9 +27,10 @@ def conveyor() -> Result:
     return simulate(load_scenario("planetary-conveyor", ["operation.t_end_s=0.03"]))
 
 
-def one_line_refusal(exc: pytest.ExceptionInfo, *words: str) -> None:
-    assert isinstance(exc.value, GearbodyError) and exc.value.exit_code == 2
-    text = str(exc.value)
+def one_line_refusal(exc: pytest.ExceptionInfo | Exception, *words: str) -> None:
+    error = exc.value if isinstance(exc, pytest.ExceptionInfo) else exc
+    assert isinstance(error, GearbodyError) and error.exit_code == 2
+    text = str(error)
     assert "\n" not in text and all(w in text for w in words), text
 
 
@@ -197,3 +198,35 @@ def test_a_compound_drive_answers_per_stage(conveyor, tmp_path):
         "load_sharing_stage_2.png",
         "ring_sensor_spectrum_stage_2.png",
     }
+
+
+def test_every_feature_evaluates_or_refuses_in_one_line_on_each_stage_kind(planetary, conveyor):
+    """Each feature of analysis.features on the planetary result and on the conveyor (spur stage first):
+    a finite value, or a one-line FeatureError. The planetary first stage refuses exactly the features
+    that read a pinion; the conveyor's 0.03 s holds too few pinion turns for a synchronous average."""
+    from gearbody.analysis.features import FEATURES, INDICATORS
+
+    refused = {}
+    for result, signal in ((planetary, "ring_sensor_N"), (conveyor, "pinion_accel_rad_s2")):
+        for name, options in FEATURES.items():
+            spec = name + (f":signal={signal},fraction=1" if "signal" in options else "")
+            try:
+                value = result.features([spec], natural_frequencies_hz=[0.0, 100.0])[spec]
+            except FeatureError as exc:
+                one_line_refusal(exc, f"feature {spec}")
+                refused[(result.name, name)] = str(exc)
+            else:
+                assert math.isfinite(value), spec
+    assert {n for s, n in refused if s == "planetary"} == {"line_amplitude", *INDICATORS}
+    assert all("parallel first stage" in m for (s, _), m in refused.items() if s == "planetary")
+    assert {n for s, n in refused if s == "planetary-conveyor"} == set(INDICATORS)
+    assert all("less than 2 revolutions" in m for (s, _), m in refused.items() if s == "planetary-conveyor")
+
+
+def test_a_signal_the_result_does_not_hold_is_a_one_line_gearbody_error(planetary):
+    from gearbody.errors import SignalError
+
+    with pytest.raises(KeyError) as exc:  # still a KeyError for mapping-style lookups
+        planetary["pinion_angle_rad"]
+    assert isinstance(exc.value, SignalError)
+    one_line_refusal(exc, "no signal 'pinion_angle_rad'", "ring_sensor_N")
