@@ -24,6 +24,19 @@ class ScenarioError(InputError):
     """Invalid scenario input; the message names file, key, value and allowed range."""
 
 
+class StageError(InputError, LookupError):
+    """A stage that does not exist, or a question that does not apply to the stage's kind (the pinion of
+    a planetary stage, the planets of a parallel one); the message names the stage and what applies
+    (exit code 2)."""
+
+
+class SignalError(InputError, KeyError):
+    """A signal a result does not hold; the message names it and the signals there are (a KeyError, so
+    mapping-style lookups keep working; exit code 2)."""
+
+    __str__ = Exception.__str__  # the message as given, not KeyError's quoted repr
+
+
 class SimulationError(GearbodyError, RuntimeError):
     """Numerical failure of a run (exit code 3): the message names the simulated time and a hint."""
 
@@ -63,7 +76,9 @@ __all__ = [
     "ReferenceMismatch",
     "RenderError",
     "ScenarioError",
+    "SignalError",
     "SimulationError",
+    "StageError",
     "StudyError",
     "StudySpecError",
 ]

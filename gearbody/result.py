@@ -12,12 +12,29 @@ import math
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
+from .errors import SignalError, StageError
+
 FINAL_FRACTION = 0.25
 """Share of the run, at its end, over which 'final' values are taken (the steady period)."""
+
+SIGNAL_UNITS = (("rad_s2", "rad/s^2"), ("m_s2", "m/s^2"), ("_N", "N"), ("_m", "m"), ("rad_s", "rad/s"))
+"""(name suffix, unit) of the signals a spectrum is taken of."""
+
+PLANET_MESHES = ("sun", "ring")
+"""The two meshes of every planet: with the sun and with the ring."""
+
+
+class PlanetaryTeeth(NamedTuple):
+    """Tooth counts of a planetary stage and its number of planets."""
+
+    sun: int
+    planet: int
+    ring: int
+    planets: int
 
 
 @dataclass
@@ -32,7 +49,7 @@ class Result:
         try:
             return self.signals[name]
         except KeyError:
-            raise KeyError(f"no signal {name!r}; signals: {', '.join(sorted(self.signals))}") from None
+            raise SignalError(f"no signal {name!r}; signals: {', '.join(sorted(self.signals))}") from None
 
     def __contains__(self, name: str) -> bool:
         return name == "time_s" or name in self.signals
@@ -48,11 +65,22 @@ class Result:
 
     @property
     def mesh_force(self) -> np.ndarray:
-        return self.signals["mesh_force_N"]
+        """The first stage's mesh force [N] (a planetary first stage has one per planet mesh)."""
+        return self._first_mesh_signal("mesh_force_N", "force_N")
 
     @property
     def kd(self) -> np.ndarray:
-        return self.signals["kd"]
+        """The first stage's dynamic factor K_d [-] (a planetary first stage has one per planet mesh)."""
+        return self._first_mesh_signal("kd", "kd")
+
+    def _first_mesh_signal(self, name: str, planet_suffix: str) -> np.ndarray:
+        if name not in self.signals and 0 in self.planetary_stages:
+            n = self.planetary_teeth(0).planets
+            raise StageError(
+                f"Result signal {name!r}: stage 1 is planetary, with one signal per planet mesh: "
+                f"planet_<n>_sun_mesh_{planet_suffix} and planet_<n>_ring_mesh_{planet_suffix}, n = 1..{n}"
+            )
+        return self[name]
 
     @property
     def sample_rate_hz(self) -> float:
@@ -73,14 +101,39 @@ class Result:
         """``stage 1``, ``stage 2``, ... in power-flow order."""
         return [f"stage {k + 1}" for k in range(self.n_stages)]
 
+    def stage_kind(self, stage: int = 0) -> str:
+        """``"parallel"`` (a pinion and a wheel) or ``"planetary"`` (sun, planets, ring, carrier) for stage
+        ``stage`` (0-based)."""
+        return "planetary" if self._stage(stage).get("type") == "planetary" else "parallel"
+
     def teeth(self, stage: int = 0) -> tuple[int, int]:
-        """(z_pinion, z_wheel) of stage ``stage`` (0-based)."""
+        """(z_pinion, z_wheel) of parallel stage ``stage`` (0-based); a planetary stage refuses, naming
+        :meth:`planetary_teeth`."""
         st = self._stage(stage)
+        if self.stage_kind(stage) == "planetary":
+            raise StageError(
+                f"Result.teeth({stage}): stage {stage + 1} is planetary (no pinion and wheel); "
+                f"Result.planetary_teeth({stage}) gives its sun, planet and ring teeth"
+            )
         return int(st["pinion_teeth"]), int(st["wheel_teeth"])
+
+    def planetary_teeth(self, stage: int = 0) -> PlanetaryTeeth:
+        """(sun, planet, ring, planets): tooth counts and number of planets of planetary stage ``stage``
+        (0-based); a parallel stage refuses, naming :meth:`teeth`."""
+        st = self._stage(stage)
+        if self.stage_kind(stage) != "planetary":
+            raise StageError(
+                f"Result.planetary_teeth({stage}): stage {stage + 1} is a parallel stage; "
+                f"Result.teeth({stage}) gives its pinion and wheel teeth"
+            )
+        return PlanetaryTeeth(
+            int(st["sun_teeth"]), int(st["planet_teeth"]), int(st["ring_teeth"]), int(st["planets"])
+        )
 
     def stage_signal(self, name: str, stage: int = 0) -> np.ndarray:
         """Signal ``name`` of stage ``stage``: ``kd`` of stage 2 is ``stage_2_kd``, its pinion angle
-        ``pinion_2_angle_rad``."""
+        ``pinion_2_angle_rad``; a planetary stage 2's ``planet_1_sun_mesh_kd`` is
+        ``stage_2_planet_1_sun_mesh_kd``."""
         self._stage(stage)
         if stage == 0:
             return self[name]
@@ -103,15 +156,46 @@ class Result:
         return float(np.mean(self.stage_signal("mesh_frequency_hz", stage)[self.final_window(fraction)]))
 
     # -- what a diagnostician looks at ------------------------------------------------------------
-    def fold_kd(self, stage: int = 0, bins: int = 100, fraction: float = 0.25):
-        """K_d of stage ``stage`` folded over its mesh period (the paper's Figs. 5-8), from the computed
-        pinion angle, over the final ``fraction`` of the run."""
+    def fold_kd(
+        self,
+        stage: int = 0,
+        bins: int = 100,
+        fraction: float = 0.25,
+        *,
+        planet: int | None = None,
+        mesh: str | None = None,
+    ):
+        """K_d of stage ``stage`` folded over its mesh period (the paper's Figs. 5-8) over the final
+        ``fraction`` of the run. A parallel stage: from the computed pinion angle. A planetary stage: the
+        K_d of planet ``planet`` (1..N, default 1) in its ``mesh`` (``"sun"``, default, or ``"ring"``)
+        over that mesh's phase as its law computed it (one period per sun or ring tooth)."""
         from .analysis import fold_over_mesh_period
 
         win = self.final_window(fraction)
+        if self.stage_kind(stage) == "planetary":
+            name = self._planet_mesh(stage, planet, mesh)
+            phase = self.stage_signal(name + "_phase", stage)[win]
+            kd = self.stage_signal(name + "_kd", stage)[win]
+            return fold_over_mesh_period(kd, 2.0 * math.pi * phase, 1, bins=bins)
+        if planet is not None or mesh is not None:
+            raise StageError(
+                f"Result.fold_kd({stage}, planet={planet!r}, mesh={mesh!r}): stage {stage + 1} is a parallel "
+                "stage with one mesh; planet and mesh apply to planetary stages"
+            )
         kd = self.stage_signal("kd", stage)[win]
         angle = self.stage_signal("pinion_angle_rad", stage)[win]
         return fold_over_mesh_period(kd, angle, self.teeth(stage)[0], bins=bins)
+
+    def _planet_mesh(self, stage: int, planet: int | None, mesh: str | None) -> str:
+        """``planet_<n>_<mesh>_mesh`` of planetary stage ``stage``, checked (default planet 1, sun)."""
+        n = self.planetary_teeth(stage).planets
+        planet = 1 if planet is None else planet
+        mesh = "sun" if mesh is None else mesh
+        if isinstance(planet, bool) or not isinstance(planet, int | np.integer) or not 1 <= planet <= n:
+            raise StageError(f"planet = {planet!r}: stage {stage + 1} has planets 1..{n}")
+        if mesh not in PLANET_MESHES:
+            raise StageError(f"mesh = {mesh!r}: a planet of stage {stage + 1} meshes with 'sun' or 'ring'")
+        return f"planet_{planet}_{mesh}_mesh"
 
     def spectrum(
         self,
@@ -130,9 +214,23 @@ class Result:
         name = signal or self.vibration_signal_name
         win = self.final_window(fraction)
         spec = amplitude_spectrum(self[name][win], self.sample_rate_hz, window="hann")
-        f_mesh = self.mesh_frequency_hz(0, fraction)
         peaks = []
         f_max = self.sample_rate_hz / 2
+        if self.planetary_stages:
+            f_top = max(self.mesh_frequency_hz(k, fraction) for k in range(self.n_stages))
+            if f_top > 0:
+                f_max = min(f_max, (harmonics + 0.5) * f_top)
+                lines = self._compound_lines(fraction, f_max, harmonics, sidebands)
+                peaks = label_peaks(
+                    spec,
+                    lines,
+                    tolerance_hz=1.5 * spec.resolution_hz,
+                    min_prominence_db=min_prominence_db,
+                    max_peaks=max_peaks,
+                    f_max_hz=f_max,
+                )
+            return LabelledSpectrum(signal=name, spectrum=spec, peaks=peaks, f_max_hz=f_max)
+        f_mesh = self.mesh_frequency_hz(0, fraction)
         if f_mesh > 0:
             f_max = min(f_max, (harmonics + 0.5) * f_mesh)
             teeth = [self.teeth(k) for k in range(self.n_stages)]
@@ -148,14 +246,63 @@ class Result:
             )
         return LabelledSpectrum(signal=name, spectrum=spec, peaks=peaks, f_max_hz=f_max)
 
+    def _compound_lines(self, fraction: float, f_max: float, harmonics: int, sidebands: int) -> list:
+        """Kinematic lines of a drive with planetary stages: each run of consecutive parallel stages as a
+        gear train (shafts named after its pinions and wheels, meshes f_z<stage>), each planetary stage's
+        lines (docs/planetary-lines.md; labelled with their stage when the drive has several)."""
+        from dataclasses import replace
+
+        from .analysis import GearMesh, KinematicSources, Shaft, kinematic_lines
+        from .analysis.planetary_lines import planetary_lines
+        from .plotting.planetary import planetary_sources
+
+        lines: list = []
+        shafts: list = []
+        meshes: list = []
+
+        def flush() -> None:
+            if shafts:
+                sources = KinematicSources(tuple(shafts), tuple(meshes))
+                lines.extend(
+                    kinematic_lines(sources, f_max, harmonics=harmonics, sidebands=sidebands, shaft_orders=30)
+                )
+                shafts.clear()
+                meshes.clear()
+
+        several = len(self.planetary_stages) > 1
+        for k in range(self.n_stages):
+            if self.stage_kind(k) == "planetary":
+                flush()
+                stage_lines = planetary_lines(planetary_sources(self, k), f_max, harmonics=harmonics)
+                lines.extend(
+                    replace(line, label=f"{line.label} (stage {k + 1})") if several else line
+                    for line in stage_lines
+                )
+                continue
+            z1, z2 = self.teeth(k)
+            f_mesh = self.mesh_frequency_hz(k, fraction)
+            if f_mesh <= 0:
+                flush()
+                continue
+            tag = "" if k == 0 else f" {k + 1}"
+            if not shafts:
+                shafts.append(Shaft(f"pinion{tag}", f_mesh / z1))
+            shafts.append(Shaft(f"wheel{tag}", f_mesh / z2))
+            meshes.append(GearMesh(f"f_z{k + 1}", f_mesh, (shafts[-2].name, shafts[-1].name)))
+        flush()
+        return sorted(lines, key=lambda line: line.frequency_hz)
+
     @property
     def vibration_signal_name(self) -> str:
-        """The acceleration an accelerometer would read: the housing acceleration at the first lateral
-        gear's bearing, otherwise the pinion's angular acceleration (Muller: the deflection's)."""
+        """The signal a sensor on the housing would read: the housing acceleration at the first lateral
+        gear's bearing, otherwise the pinion's angular acceleration (Muller: the deflection's); a drive
+        whose first stage is planetary: the ring-fixed sensor of that stage (``ring_sensor_N``)."""
         for name in ("pinion_housing_accel_y_m_s2", "wheel_housing_accel_y_m_s2"):
             if name in self and f"{name.split('_housing')[0]}_y_m" in self:
                 return name
-        return "pinion_accel_rad_s2" if "pinion_accel_rad_s2" in self else "deflection_accel_m_s2"
+        if "pinion_accel_rad_s2" in self:
+            return "pinion_accel_rad_s2"
+        return "ring_sensor_N" if "ring_sensor_N" in self else "deflection_accel_m_s2"
 
     @property
     def bearing_gears(self) -> list[str]:
@@ -337,11 +484,15 @@ class Result:
         from ``gearbody.engine.natural_frequencies`` or measured, for the natural-frequency features)."""
         from .analysis.features import Record
 
+        if self.meta.get("stages"):
+            teeth = self.teeth(0) if self.stage_kind(0) == "parallel" else (None, None)
+        else:  # a result put together by hand: the teeth its metadata gives
+            teeth = (self.meta.get("pinion_teeth"), self.meta.get("wheel_teeth"))
         return Record(
             time_s=self.time_s,
             signals=self.signals,
-            pinion_teeth=int(self.meta["pinion_teeth"]),
-            wheel_teeth=int(self.meta["wheel_teeth"]),
+            pinion_teeth=teeth[0],
+            wheel_teeth=teeth[1],
             period_boundaries_s=self.period_boundaries_s(),
             natural_frequencies_hz=tuple(float(f) for f in natural_frequencies_hz),
         )
@@ -354,21 +505,26 @@ class Result:
         return evaluate_features(specs, self.record(natural_frequencies_hz))
 
     def plot(self, out_dir: str | Path) -> list[Path]:
-        """The run's standard PNGs in ``out_dir``: K_d over time, K_d folded over the mesh period, the
-        spectrum of the vibration signal, bearing forces (gearbody.plotting.run)."""
+        """The run's standard PNGs in ``out_dir``: per parallel stage K_d over time and folded over the
+        mesh period, the spectrum of the vibration signal, bearing forces (gearbody.plotting.run); per
+        planetary stage its planet meshes' K_d, load sharing and ring-sensor spectrum
+        (gearbody.plotting.planetary)."""
         from .plotting.run import write_plots
 
         Path(out_dir).mkdir(parents=True, exist_ok=True)
+        paths = write_plots(self, out_dir)
         if self.planetary_stages:
             from .plotting.planetary import write_planetary_plots
 
-            return write_planetary_plots(self, out_dir)
-        return write_plots(self, out_dir)
+            paths += write_planetary_plots(self, out_dir)
+        return paths
 
     def _stage(self, stage: int) -> dict[str, Any]:
         stages = self.meta.get("stages") or []
-        if not 0 <= stage < len(stages):
-            raise IndexError(f"stage {stage}: the result has {len(stages)} stage(s), 0..{len(stages) - 1}")
+        if isinstance(stage, bool) or not isinstance(stage, int | np.integer) or not 0 <= stage < len(stages):
+            raise StageError(
+                f"stage = {stage!r}: the result has {len(stages)} stage(s), 0..{len(stages) - 1} (0-based)"
+            )
         return stages[stage]
 
     def save_npz(self, path: str | Path) -> Path:
@@ -410,7 +566,7 @@ class LabelledSpectrum:
         """The spectrum with its labelled peaks (matplotlib axes; a new figure when ``ax`` is None)."""
         from .plotting.spectrum import plot_labelled_spectrum
 
-        unit = "rad/s^2" if self.signal.endswith("rad_s2") else "m/s^2"
+        unit = next((u for suffix, u in SIGNAL_UNITS if self.signal.endswith(suffix)), "")
         return plot_labelled_spectrum(
             self.spectrum,
             self.peaks,

@@ -292,6 +292,9 @@ def test_run_report_and_sweep_on_the_compound_drive(tmp_path, capsys):
     assert summary["stage_2_sun_mesh_load_sharing_factor"] >= 1.0
     assert summary["stage_2_ring_mesh_kd_mean_final"] == pytest.approx(1.0, abs=0.05)
     assert {p.name for p in out.glob("*.png")} == {
+        "kd_time.png",  # the spur stage's K_d over time, folded, and the spectrum
+        "kd_folded.png",
+        "spectrum.png",
         "planet_kd_time_stage_2.png",
         "load_sharing_stage_2.png",
         "ring_sensor_spectrum_stage_2.png",

@@ -9,8 +9,10 @@ signal suffice for the spectral features). A feature is named by a short spec, `
 
 ======================================  =======================================================
 ``kd_max``, ``kd_mean``, ``kd_min``,     K_d statistic [-] of stage ``stage`` (default 1) over the
-``kd_std``, ``kd_p50/p95/p99``           analysed window
-``separation_fraction``                  fraction of the window with no contact force [-]
+``kd_std``, ``kd_p50/p95/p99``           analysed window; a planetary stage: over its planet meshes,
+                                         all or ``planet`` (1..N) and ``mesh`` (sun or ring)
+``separation_fraction``                  fraction of the window with no contact force [-] (a
+                                         planetary stage: the largest of its planet meshes')
 ``rms``                                  RMS of ``signal`` over the window [signal unit]
 ``line_amplitude``                       amplitude [signal unit] of the spectral line at
                                          ``mesh`` x f_z + ``order`` x f_``shaft`` in ``signal``
@@ -25,6 +27,12 @@ signal suffice for the spectral features). A feature is named by a short spec, `
 The analysed window is operating period ``period`` (1-based, from ``Record.period_boundaries_s``), or
 ``from_s``/``to_s``, or by default the final ``fraction`` (0.25) of the record: the steady end of a
 run. The resonance speed of a speed sweep is :func:`resonance_speed`.
+
+A stage is planetary when the record holds its planet meshes' signals (``planet_<n>_sun_mesh_kd``,
+stage k > 1: ``stage_k_planet_<n>_...``, as a Result names them). The spectral features
+(``line_amplitude``) and the synchronous-average indicators read a parallel first stage's pinion (its
+angle and the pinion and wheel teeth); a record without those (a drive whose first stage is planetary)
+refuses them.
 """
 
 from __future__ import annotations
@@ -35,6 +43,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from gearbody.errors import InputError
 
 from .dynamic_factor import separation_stats
 from .indicators import condition_indicators_from_average, rms
@@ -48,6 +58,7 @@ __all__ = [
     "Record",
     "evaluate_feature",
     "evaluate_features",
+    "feature_signals",
     "kd_statistic",
     "line_amplitude",
     "line_frequency_hz",
@@ -71,9 +82,13 @@ INDICATORS = {
     "tsa_peak_to_peak": "peak_to_peak",
 }
 WINDOW_OPTIONS = ("period", "from_s", "to_s", "fraction")
+MESH_OPTIONS = ("stage", "planet", "mesh")
+"""Which mesh a K_d feature reads: the stage (1-based) and, on a planetary stage, the planet (1..N) and
+the mesh (``sun`` or ``ring``); without them every planet mesh of the stage."""
+PLANET_MESHES = ("sun", "ring")
 FEATURES: dict[str, tuple[str, ...]] = {
-    **{f"kd_{s}": ("stage", *WINDOW_OPTIONS) for s in KD_STATISTICS},
-    "separation_fraction": ("stage", *WINDOW_OPTIONS),
+    **{f"kd_{s}": (*MESH_OPTIONS, *WINDOW_OPTIONS) for s in KD_STATISTICS},
+    "separation_fraction": (*MESH_OPTIONS, *WINDOW_OPTIONS),
     "rms": ("signal", *WINDOW_OPTIONS),
     "line_amplitude": ("signal", "mesh", "order", "shaft", "tolerance_bins", *WINDOW_OPTIONS),
     **{name: ("signal", "gear", *WINDOW_OPTIONS) for name in INDICATORS},
@@ -82,9 +97,10 @@ FEATURES: dict[str, tuple[str, ...]] = {
 """Every feature name and the options it takes."""
 
 
-class FeatureError(ValueError):
+class FeatureError(InputError):
     """A feature spec that names no feature, takes an option it does not have, or cannot be computed
-    from the record (a missing signal, an empty window, an unknown natural frequency)."""
+    from the record (a missing signal, an empty window, an unknown natural frequency, a stage of the
+    wrong kind); a ValueError, and a gearbody input error (exit code 2)."""
 
 
 # -- the feature functions on plain arrays ------------------------------------------------------------
@@ -169,14 +185,17 @@ class Record:
     """Signals on one uniform time grid and the facts of the drive that features need.
 
     ``signals`` by name as a Result names them: ``kd``, ``mesh_force_N`` (stage k > 1: ``stage_k_kd``, ...),
+    a planetary stage's ``planet_<n>_sun_mesh_kd``, ``planet_<n>_ring_mesh_force_N``, ...,
     ``pinion_angle_rad`` (a tachometer's angle suffices for spectra and synchronous averages), any
-    vibration signal. ``period_boundaries_s``: start of the first operating period, every boundary, end.
+    vibration signal. ``pinion_teeth``, ``wheel_teeth``: of a parallel first stage (None when the first
+    stage is planetary: the spectral and synchronous-average features then do not apply).
+    ``period_boundaries_s``: start of the first operating period, every boundary, end.
     """
 
     time_s: NDArray[np.float64]
     signals: Mapping[str, NDArray[np.float64]]
-    pinion_teeth: int
-    wheel_teeth: int
+    pinion_teeth: int | None = None
+    wheel_teeth: int | None = None
     period_boundaries_s: tuple[float, ...] = ()
     natural_frequencies_hz: tuple[float, ...] = ()
 
@@ -190,8 +209,12 @@ class Record:
                     f"Record signal {name!r}: {np.shape(values)} samples, time_s has {t.shape}"
                 )
         for name in ("pinion_teeth", "wheel_teeth"):
-            if int(getattr(self, name)) < 1:
+            if getattr(self, name) is not None and int(getattr(self, name)) < 1:
                 raise FeatureError(f"Record.{name} = {getattr(self, name)}: must be >= 1")
+        if (self.pinion_teeth is None) != (self.wheel_teeth is None):
+            raise FeatureError(
+                "Record: give both pinion_teeth and wheel_teeth, or neither (no parallel stage 1)"
+            )
 
     @property
     def sample_rate_hz(self) -> float:
@@ -223,6 +246,18 @@ class Record:
         if np.count_nonzero(mask) < 2:
             raise FeatureError(f"window {dict(options)}: fewer than 2 samples")
         return mask
+
+    def planets(self, stage: int = 1) -> tuple[int, ...]:
+        """Planet numbers of stage ``stage`` (1-based) whose mesh K_d the record holds; () for a parallel
+        stage."""
+        prefix = _stage_name("", stage)
+        found = set()
+        for name in self.signals:
+            if name.startswith(prefix + "planet_") and name.endswith("_sun_mesh_kd"):
+                number = name[len(prefix + "planet_") : -len("_sun_mesh_kd")]
+                if number.isdigit():
+                    found.add(int(number))
+        return tuple(sorted(found))
 
     def pinion_hz(self, mask: NDArray[np.bool_], stage: int = 1) -> float:
         """Mean pinion rotation frequency [Hz] over the window, from the pinion angle."""
@@ -264,16 +299,16 @@ def parse_feature(text: str) -> FeatureSpec:
                 f"feature {text!r}: option {item!r} not understood; {name} takes "
                 f"{', '.join(f'{o}=...' for o in FEATURES[name])}"
             )
-        options[key] = _option_value(text, key, value)
+        options[key] = _option_value(text, key, value, name)
     return FeatureSpec(name, options)
 
 
-_INT_OPTIONS = ("period", "stage", "mesh", "order", "mode")
+_INT_OPTIONS = ("period", "stage", "planet", "mesh", "order", "mode")
 _STR_OPTIONS = ("signal", "shaft", "gear")
 
 
-def _option_value(text: str, key: str, value: str) -> float | str:
-    if key in _STR_OPTIONS:
+def _option_value(text: str, key: str, value: str, name: str = "") -> float | str:
+    if key in _STR_OPTIONS or (key == "mesh" and "planet" in FEATURES.get(name, ())):
         return value
     try:
         number = float(value)
@@ -294,29 +329,90 @@ def _stage_name(name: str, stage: int) -> str:
     return name if stage == 1 else f"stage_{stage}_{name}"
 
 
+def _mesh_signals(spec: FeatureSpec, record: Record, quantity: str) -> tuple[str, ...]:
+    """The ``quantity`` (``kd`` or ``force_N``) signals of the meshes ``spec`` names: a parallel stage's
+    one mesh, or a planetary stage's planet meshes (all, or ``planet`` and/or ``mesh``)."""
+    o = spec.options
+    stage = int(o.get("stage", 1))
+    planets = record.planets(stage)
+    if not planets:
+        if "planet" in o or "mesh" in o:
+            raise FeatureError(
+                f"feature {spec}: stage {stage} is no planetary stage (the record has no "
+                f"{_stage_name('planet_1_sun_mesh_kd', stage)!r}); planet and mesh apply to planetary stages"
+            )
+        return (_stage_name("kd" if quantity == "kd" else "mesh_force_N", stage),)
+    chosen = planets
+    if "planet" in o:
+        if int(o["planet"]) not in planets:
+            raise FeatureError(
+                f"feature {spec}: planet = {o['planet']}; stage {stage} has planets "
+                f"{planets[0]}..{planets[-1]}"
+            )
+        chosen = (int(o["planet"]),)
+    meshes = PLANET_MESHES
+    if "mesh" in o:
+        if o["mesh"] not in PLANET_MESHES:
+            raise FeatureError(f"feature {spec}: mesh = {o['mesh']!r}; valid are 'sun', 'ring'")
+        meshes = (str(o["mesh"]),)
+    return tuple(_stage_name(f"planet_{n}_{m}_mesh_{quantity}", stage) for n in chosen for m in meshes)
+
+
+def _parallel_first_stage(spec: FeatureSpec, record: Record) -> tuple[int, int]:
+    """(pinion, wheel) teeth of the record's parallel first stage, which the spectral and synchronous-
+    average features read; refused when the record has none."""
+    if record.pinion_teeth is None or record.wheel_teeth is None:
+        raise FeatureError(
+            f"feature {spec}: reads a parallel first stage (its pinion angle and pinion/wheel teeth) and "
+            "this record has none (its first stage is planetary); on a planetary stage use kd_*, "
+            "separation_fraction, rms or natural_frequency_hz"
+        )
+    return int(record.pinion_teeth), int(record.wheel_teeth)
+
+
+def feature_signals(spec: FeatureSpec | str, record: Record) -> tuple[str, ...]:
+    """Names of the signals the feature reads from ``record`` (whether the record holds them or not);
+    FeatureError when the feature does not apply to the stage it names (a planet of a parallel stage, a
+    spectral line of a record without a parallel first stage)."""
+    spec = parse_feature(spec) if isinstance(spec, str) else spec
+    name, o = spec.name, spec.options
+    if name == "natural_frequency_hz":
+        return ()
+    if name.startswith("kd_"):
+        return _mesh_signals(spec, record, "kd")
+    if name == "separation_fraction":
+        return _mesh_signals(spec, record, "force_N")
+    if "signal" not in o:
+        raise FeatureError(f"feature {spec}: give the signal, e.g. {name}:signal=pinion_accel_rad_s2")
+    if name == "rms":
+        return (str(o["signal"]),)
+    _parallel_first_stage(spec, record)
+    extra = ("wheel_angle_rad",) if name != "line_amplitude" and o.get("gear") == "wheel" else ()
+    return (str(o["signal"]), "pinion_angle_rad", *(e for e in extra if e in record.signals))
+
+
 def evaluate_feature(spec: FeatureSpec | str, record: Record) -> float:
     """The value of one feature of ``record`` (see the module's table for names, options and units)."""
     spec = parse_feature(spec) if isinstance(spec, str) else spec
     name, o = spec.name, dict(spec.options)
     if name == "natural_frequency_hz":
         return natural_frequency_hz(record.natural_frequencies_hz, int(o.get("mode", 1)))
-    if "signal" in FEATURES[name] and "signal" not in o:
-        raise FeatureError(f"feature {spec}: give the signal, e.g. {name}:signal=pinion_accel_rad_s2")
+    names = feature_signals(spec, record)
     mask = record.window(o)
-    stage = int(o.get("stage", 1))
     if name.startswith("kd_"):
-        return kd_statistic(record.signal(_stage_name("kd", stage))[mask], name[3:])
+        return kd_statistic(np.concatenate([record.signal(n)[mask] for n in names]), name[3:])
     if name == "separation_fraction":
-        force = record.signal(_stage_name("mesh_force_N", stage))[mask]
-        return float(separation_stats(force, record.time_s[mask]).separated_fraction)
+        t = record.time_s[mask]
+        return float(max(separation_stats(record.signal(n)[mask], t).separated_fraction for n in names))
     x = record.signal(str(o["signal"]))[mask]
     if name == "rms":
         return rms(x)
+    z1, z2 = _parallel_first_stage(spec, record)
     if name == "line_amplitude":
         f = line_frequency_hz(
             record.pinion_hz(mask),
-            record.pinion_teeth,
-            record.wheel_teeth,
+            z1,
+            z2,
             int(o.get("mesh", 1)),
             int(o.get("order", 0)),
             str(o.get("shaft", "pinion")),
@@ -324,11 +420,7 @@ def evaluate_feature(spec: FeatureSpec | str, record: Record) -> float:
         bins = float(o.get("tolerance_bins", 2.0))
         if int(o.get("order", 0)) != 0:  # a sideband or shaft order: its neighbours lie f_shaft away
             shaft = str(o.get("shaft", "pinion"))
-            f_shaft = abs(
-                line_frequency_hz(
-                    record.pinion_hz(mask), record.pinion_teeth, record.wheel_teeth, 0, 1, shaft
-                )
-            )
+            f_shaft = abs(line_frequency_hz(record.pinion_hz(mask), z1, z2, 0, 1, shaft))
             tolerance_hz = bins * record.sample_rate_hz / np.count_nonzero(mask)
             if tolerance_hz >= f_shaft / 2:
                 duration = record.time_s[mask][-1] - record.time_s[mask][0]
@@ -341,10 +433,10 @@ def evaluate_feature(spec: FeatureSpec | str, record: Record) -> float:
     gear = str(o.get("gear", "pinion"))
     if gear not in ("pinion", "wheel"):
         raise FeatureError(f"feature {spec}: gear = {gear!r}; valid are 'pinion', 'wheel'")
-    angle, teeth = record.signal("pinion_angle_rad")[mask], record.pinion_teeth
+    angle, teeth = record.signal("pinion_angle_rad")[mask], z1
     if gear == "wheel":  # its own angle if recorded, else the pinion's through the tooth ratio
-        teeth = record.wheel_teeth
-        ratio = record.pinion_teeth / record.wheel_teeth
+        teeth = z2
+        ratio = z1 / z2
         angle = (
             record.signal("wheel_angle_rad")[mask] if "wheel_angle_rad" in record.signals else angle * ratio
         )

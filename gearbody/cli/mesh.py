@@ -20,7 +20,10 @@ def register(sub) -> argparse.ArgumentParser:
             "contact ratios, backlash, k_z single/double/mean, ISO 6336-1 method B, potential-energy mean) "
             "and write DIR/mesh_stage<N>.png: k_z over the mesh cycle, k_z around each damaged tooth next "
             "to the healthy curve, and the static transmission error F/k - E + l_u under load over a "
-            "pinion turn. Evaluated with the solver's own mesh law, no simulation. See docs/mesh.md."
+            "pinion turn. A planetary stage: its teeth, radii and both planet meshes' table, k_z of the "
+            "sun-planet and ring-planet law over the mesh cycle, each damaged tooth in the meshes it "
+            "enters, and planet 1's static TE in each mesh. Evaluated with the solver's own mesh law, no "
+            "simulation. See docs/mesh.md."
         ),
     )
     me.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
@@ -46,8 +49,15 @@ def register(sub) -> argparse.ArgumentParser:
 
 def execute(args) -> int:
     out = None if args.no_plots else check_out(args.out or default_out(args.scene, "mesh"))
-    from gearbody.plotting.mesh import plot_stage
+    from gearbody.plotting.mesh import plot_planetary_stage, plot_stage
     from gearbody.reports.mesh import damage_windows, static_transmission_error, stiffness_cycle, summary_text
+    from gearbody.reports.mesh.planetary import (
+        is_planetary,
+        planetary_damage_windows,
+        planetary_static_transmission_errors,
+        planetary_stiffness_cycles,
+        planetary_summary_text,
+    )
 
     scenario = load(args.scene, args.overrides)
     count = len(scenario.stages)
@@ -61,11 +71,19 @@ def execute(args) -> int:
     print(f"{scenario.meta.title}")
     written = []
     for k in stages:
+        path = None if args.no_plots else out / f"mesh_stage{k + 1}.png"
+        if is_planetary(scenario, k):
+            cycles, windows = planetary_stiffness_cycles(scenario, k), planetary_damage_windows(scenario, k)
+            tes = planetary_static_transmission_errors(scenario, k, args.load)
+            print(planetary_summary_text(scenario, k, args.load, cycles=cycles, windows=windows, tes=tes))
+            if path is not None:
+                written.append(plot_planetary_stage(scenario, k, path, cycles, windows, tes))
+            continue
         cycle, windows = stiffness_cycle(scenario, k), damage_windows(scenario, k)
         te = static_transmission_error(scenario, k, args.load)
         print(summary_text(scenario, k, args.load, cycle=cycle, windows=windows, te=te))
-        if not args.no_plots:
-            written.append(plot_stage(scenario, k, out / f"mesh_stage{k + 1}.png", cycle, windows, te))
+        if path is not None:
+            written.append(plot_stage(scenario, k, path, cycle, windows, te))
     if written:
         print(f"wrote {', '.join(str(p) for p in written)}")
     return EXIT_OK

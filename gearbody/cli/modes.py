@@ -1,5 +1,6 @@
 """``gearbody modes SCENE``: natural frequencies at mean mesh stiffness, their dominant motion, and the
-pinion speeds where mesh harmonics meet them (:mod:`gearbody.analysis.modal`)."""
+first stage's input speeds where its mesh harmonics meet them (:mod:`gearbody.analysis.modal`): the
+pinion's speed, or a planetary first stage's input member's."""
 
 from __future__ import annotations
 
@@ -16,7 +17,8 @@ def register(sub) -> argparse.ArgumentParser:
         "modes",
         help=about,
         description=f"{about[0].upper()}{about[1:]}: the linearised model's modes with their dominant"
-        " motion, and the pinion speeds at which the first mesh harmonics meet them.",
+        " motion, and the speeds of the first stage's input (the pinion; a planetary stage's input member,"
+        " e.g. the sun) at which that stage's first mesh harmonics meet them.",
     )
     modes.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
     add_set(modes, "override a scenario value (as for run)")
@@ -36,7 +38,7 @@ def execute(args) -> int:
 
     scenario = load(args.scene, args.overrides)
     modes = scene_modes(scenario)
-    z1 = scenario.stages[0].pinion.teeth
+    z1, footnote = _first_stage_input(scenario.stages[0])
     k = ", ".join(f"{x:.4g}" for x in modes.mean_mesh_stiffness_N_per_m)
     print(f"{scenario.meta.title}")
     print(f"linearised at mean mesh stiffness {k} N/m; DOFs: {', '.join(modes.dof_names)}")
@@ -49,5 +51,22 @@ def execute(args) -> int:
     for m, f in enumerate(modes.frequencies_hz):
         cols = "".join(f"{'-' if math.isnan(s) else f'{s:.2f}':>18}" for s in speeds[:, m])
         print(f"{m + 1:>4} {f:12.3f}  {modes.label(m):<{width}}{cols}")
-    print(f"(w(k f_z) = pinion speed at which the k-th mesh harmonic z1 w k / 2 pi meets f_n; z1 = {z1})")
+    print(footnote)
     return EXIT_OK
+
+
+def _first_stage_input(stage) -> tuple[float, str]:
+    """(mesh periods per revolution of the first stage's input, the table's footnote): the pinion's teeth
+    z1, or for a planetary first stage f_m / f_in of rigid rolling (Willis), f_m = z_s |w_s - w_c| / 2 pi."""
+    if getattr(stage, "type", "") != "planetary":
+        z1 = stage.pinion.teeth
+        return (
+            z1,
+            f"(w(k f_z) = pinion speed at which the k-th mesh harmonic z1 w k / 2 pi meets f_n; z1 = {z1})",
+        )
+    per_rev = 2 * math.pi * stage.mesh_frequency_hz(1.0)
+    return per_rev, (
+        f"(w(k f_z) = {stage.input} speed (the planetary first stage's input) at which the k-th mesh "
+        f"harmonic k f_m meets f_n; f_m = z_s |w_s - w_c| / 2 pi = {per_rev:.5g} w / 2 pi with the "
+        f"{stage.fixed} fixed, z_s/z_p/z_r = {stage.sun.teeth}/{stage.planet.teeth}/{stage.ring.teeth})"
+    )

@@ -30,8 +30,11 @@ def register(sub) -> argparse.ArgumentParser:
         description=(
             "Simulate SCENE and write DIR/result.npz (named arrays: time, mesh_force_N, kd, "
             "angles, speeds, accelerations, ...), DIR/scenario.toml (fully resolved, re-runnable "
-            "with 'gearbody run DIR/scenario.toml'), DIR/summary.json and PNG plots (K_d over "
-            "time, K_d folded over the mesh period, spectrum of the pinion acceleration)."
+            "with 'gearbody run DIR/scenario.toml'), DIR/summary.json and PNG plots: per parallel "
+            "stage K_d over time and folded over the mesh period (stage k > 1: kd_time_stage_k.png, "
+            "...), the spectrum of the pinion acceleration (lateral: housing acceleration) when the "
+            "first stage is parallel, per planetary stage the planets' K_d, the load sharing and the "
+            "ring-sensor spectrum."
         ),
     )
     run.add_argument(

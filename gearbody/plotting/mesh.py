@@ -25,7 +25,7 @@ from gearbody.reports.mesh.stage import stage_label
 
 from .figure import PathLike, new_figure, save_figure
 
-__all__ = ["plot_stage"]
+__all__ = ["plot_planetary_stage", "plot_stage"]
 
 MAX_WINDOWS_PLOTTED = 4
 _PERIODS_LABEL = "Mesh periods u = phi_p z1 / 2 pi [-]"
@@ -142,6 +142,62 @@ def plot_stage(
     for ax, w in zip(axes[1 : 1 + len(shown)], shown, strict=True):
         _plot_window(ax, w)
     _plot_te(axes[-1], te)
+    if len(windows) > len(shown):
+        fig.text(0.01, 0.005, f"{len(windows) - len(shown)} more damaged teeth not shown", fontsize=8)
+    return save_figure(fig, path, dpi)
+
+
+def plot_planetary_stage(
+    scenario,
+    stage: int,
+    path: PathLike,
+    cycles: dict[str, StiffnessCycle] | None = None,
+    windows: list[DamageWindow] | None = None,
+    tes: dict[str, StaticTransmissionError] | None = None,
+    load_fraction: float = 1.0,
+    width_px: int = 1100,
+    dpi: int = 100,
+) -> Path:
+    """One PNG of a planetary stage: k_z of the sun-planet and the ring-planet law over the mesh cycle
+    (healthy), k_z around each damaged tooth (at most MAX_WINDOWS_PLOTTED panels) and planet 1's static
+    transmission error in each mesh over one revolution of the sun (ring) relative to its line of
+    centres. Data not passed in is computed with :mod:`gearbody.reports.mesh.planetary`'s defaults."""
+    from gearbody.reports.mesh.planetary import (
+        PLANET_MESHES,
+        planetary_damage_windows,
+        planetary_static_transmission_errors,
+        planetary_stiffness_cycles,
+    )
+
+    cycles = planetary_stiffness_cycles(scenario, stage) if cycles is None else cycles
+    windows = planetary_damage_windows(scenario, stage) if windows is None else windows
+    tes = planetary_static_transmission_errors(scenario, stage, load_fraction) if tes is None else tes
+    shown = windows[:MAX_WINDOWS_PLOTTED]
+    rows = 4 + len(shown)
+    fig = new_figure((width_px, 330 * rows), dpi)
+    axes = fig.subplots(rows, 1, squeeze=False)[:, 0]
+    st = scenario.stages[stage]
+    fig.suptitle(
+        f"{scenario.meta.title}\n{stage_label(scenario, stage)}: planetary, z_s/z_p/z_r = "
+        f"{st.sun.teeth}/{st.planet.teeth}/{st.ring.teeth}, {st.planets} planets",
+        fontsize=10,
+    )
+    for ax, mesh in zip(axes[:2], PLANET_MESHES, strict=True):
+        _plot_cycle(ax, cycles[mesh])
+        ax.set_title(f"{mesh}-planet mesh: k_z over the mesh cycle, healthy teeth", fontsize=10)
+        ax.set_xlabel(f"Mesh periods u = (law angle) z_{mesh[0]} / 2 pi [-]")
+    for ax, w in zip(axes[2 : 2 + len(shown)], shown, strict=True):
+        _plot_window(ax, w)
+        ax.set_xlabel("Mesh periods u = (law angle) z1 / 2 pi [-]")
+    for ax, mesh in zip(axes[-2:], PLANET_MESHES, strict=True):
+        te = tes[mesh]
+        _plot_te(ax, te)
+        ax.set_title(
+            f"{mesh}-planet mesh, planet 1: static TE F/k - E + l_u at F = {te.force_N:.5g} N "
+            f"({load_label(te)})",
+            fontsize=10,
+        )
+        ax.set_xlabel(f"Mesh periods u (one {mesh} revolution relative to the line of centres)")
     if len(windows) > len(shown):
         fig.text(0.01, 0.005, f"{len(windows) - len(shown)} more damaged teeth not shown", fontsize=8)
     return save_figure(fig, path, dpi)

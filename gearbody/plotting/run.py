@@ -1,5 +1,6 @@
-"""The standard PNG plots of a run (``gearbody run``): K_d over time, K_d folded over the mesh period,
-the spectrum of the vibration signal and, for lateral gears, the bearing forces."""
+"""The standard PNG plots of a run (``gearbody run``): per parallel stage K_d over time and K_d folded over
+its mesh period, the spectrum of the vibration signal and, for lateral gears, the bearing forces. A
+drive's planetary stages add their own plots (:mod:`gearbody.plotting.planetary`)."""
 
 from __future__ import annotations
 
@@ -15,50 +16,35 @@ if TYPE_CHECKING:  # Result.plot() calls this module
 
 from .result import plot_kd_folded, plot_kd_time, plot_signals, plot_spectrum
 
-__all__ = ["write_plots"]
+__all__ = ["parallel_stage_plot_names", "write_plots"]
+
+
+def parallel_stage_plot_names(result: Result) -> list[str]:
+    """The file names :func:`write_plots` gives the K_d plots of the result's parallel stages: stage 1
+    ``kd_time.png``, ``kd_folded.png``; stage k > 1 ``kd_time_stage_k.png``, ``kd_folded_stage_k.png``."""
+    names = []
+    for k in range(result.n_stages):
+        if result.stage_kind(k) == "parallel":
+            tag = "" if k == 0 else f"_stage_{k + 1}"
+            names += [f"kd_time{tag}.png", f"kd_folded{tag}.png"]
+    return names
 
 
 def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
-    """K_d over time, K_d folded over the mesh period (final window), spectrum of the acceleration."""
+    """Per parallel stage: K_d over time and folded over its mesh period (final window); when the first
+    stage is parallel, the spectrum of the vibration signal (``spectrum.png``); bearing forces of lateral
+    gears. A drive without parallel stages gets none of these."""
     out = Path(out_dir)
     title = result.meta.get("title", result.meta.get("scene", ""))
-    paths = [
-        plot_kd_time(result.time_s, result.kd, out / "kd_time.png", title=f"{title}: K_d = F(t)/F_rated")
-    ]
-    win = result.final_window()  # the steady end of the run (Result.FINAL_FRACTION)
-    f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
-    # at most one bin per sample of a mesh period, so that every bin is filled
-    bins = int(np.clip(result.sample_rate_hz / max(f_mesh, 1e-9), 10, 100))
-    folded = fold_over_mesh_period(
-        result.kd[win], result["pinion_angle_rad"][win], result.teeth(0)[0], bins=bins
-    )
-    paths.append(
-        plot_kd_folded(
-            folded,
-            out / "kd_folded.png",
-            title=f"{title}: K_d over the mesh period (last {result.FINAL_FRACTION:.0%} of run)",
-        )
-    )
-    name = result.vibration_signal_name
-    t_win = result.time_s[win]
-    spec = amplitude_spectrum(result[name][win], result.sample_rate_hz)
-    z1, z2 = result.teeth(0)
-    shafts = {"f_1": f_mesh / z1, "f_2": f_mesh / z2} if f_mesh > 0 else {}
-    unit = "rad/s²" if name.endswith("rad_s2") else "m/s²"
-    paths.append(
-        plot_spectrum(
-            spec,
-            out / "spectrum.png",
-            mesh_frequency_hz=f_mesh if f_mesh > 0 else None,
-            shaft_frequencies_hz=shafts,
-            title=f"{title}: spectrum of {name}, t = {t_win[0]:.3g}-{t_win[-1]:.3g} s"
-            f" (last {result.FINAL_FRACTION:.0%} of the run, run-up left out)",
-            fmax_hz=min(result.sample_rate_hz / 2, 8 * f_mesh if f_mesh > 0 else 1e9),
-            ylabel=f"amplitude [{unit}]",
-            log_amplitude=True,
-        )
-    )
-    gears = result.bearing_gears
+    paths: list[Path] = []
+    for k in range(result.n_stages):
+        if result.stage_kind(k) == "parallel":
+            paths += _stage_kd_plots(result, k, out, title)
+    if result.stage_kind(0) == "parallel":
+        paths.append(_spectrum_plot(result, out, title))
+    # parallel gears on lateral bearings (a drive with planetary stages has none: its bearing forces are
+    # the planetary members')
+    gears = [] if result.planetary_stages else result.bearing_gears
     if gears:
         paths.append(
             plot_signals(
@@ -74,3 +60,53 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
             )
         )
     return paths
+
+
+def _stage_kd_plots(result: Result, stage: int, out: Path, title: str) -> list[Path]:
+    """K_d of parallel stage ``stage`` (0-based) over time and folded over its mesh period."""
+    tag = "" if stage == 0 else f"_stage_{stage + 1}"
+    which = f", stage {stage + 1}" if result.n_stages > 1 else ""
+    kd = result.stage_signal("kd", stage)
+    paths = [
+        plot_kd_time(
+            result.time_s, kd, out / f"kd_time{tag}.png", title=f"{title}: K_d = F(t)/F_rated{which}"
+        )
+    ]
+    win = result.final_window()  # the steady end of the run (Result.FINAL_FRACTION)
+    f_mesh = float(np.mean(result.stage_signal("mesh_frequency_hz", stage)[win]))
+    # at most one bin per sample of a mesh period, so that every bin is filled
+    bins = int(np.clip(result.sample_rate_hz / max(f_mesh, 1e-9), 10, 100))
+    folded = fold_over_mesh_period(
+        kd[win], result.stage_signal("pinion_angle_rad", stage)[win], result.teeth(stage)[0], bins=bins
+    )
+    paths.append(
+        plot_kd_folded(
+            folded,
+            out / f"kd_folded{tag}.png",
+            title=f"{title}: K_d over the mesh period{which} (last {result.FINAL_FRACTION:.0%} of run)",
+        )
+    )
+    return paths
+
+
+def _spectrum_plot(result: Result, out: Path, title: str) -> Path:
+    """Spectrum of the vibration signal over the final window, first stage's mesh harmonics and shafts."""
+    win = result.final_window()
+    f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
+    name = result.vibration_signal_name
+    t_win = result.time_s[win]
+    spec = amplitude_spectrum(result[name][win], result.sample_rate_hz)
+    z1, z2 = result.teeth(0)
+    shafts = {"f_1": f_mesh / z1, "f_2": f_mesh / z2} if f_mesh > 0 else {}
+    unit = "rad/s²" if name.endswith("rad_s2") else "m/s²"
+    return plot_spectrum(
+        spec,
+        out / "spectrum.png",
+        mesh_frequency_hz=f_mesh if f_mesh > 0 else None,
+        shaft_frequencies_hz=shafts,
+        title=f"{title}: spectrum of {name}, t = {t_win[0]:.3g}-{t_win[-1]:.3g} s"
+        f" (last {result.FINAL_FRACTION:.0%} of the run, run-up left out)",
+        fmax_hz=min(result.sample_rate_hz / 2, 8 * f_mesh if f_mesh > 0 else 1e9),
+        ylabel=f"amplitude [{unit}]",
+        log_amplitude=True,
+    )

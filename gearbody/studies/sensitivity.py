@@ -655,32 +655,29 @@ PROBE_S = 0.002
 
 def check_feature_signals(base: Mapping[str, Any], overrides: Sequence[str], specs) -> None:
     """Every signal the features read is one the scene records: a probe run of PROBE_S finds them."""
-    need = {}
-    for spec in specs:
-        stage = int(spec.options.get("stage", 1))
-        prefix = "" if stage == 1 else f"stage_{stage}_"
-        if spec.name.startswith("kd_"):
-            need[f"{prefix}kd"] = spec
-        elif spec.name == "separation_fraction":
-            need[f"{prefix}mesh_force_N"] = spec
-        elif "signal" in spec.options:
-            need[str(spec.options["signal"])] = spec
-    if not need:
+    from gearbody.analysis.features import FeatureError, feature_signals
+
+    if all(spec.name == "natural_frequency_hz" for spec in specs):
         return
     from gearbody.engine import simulate
     from gearbody.errors import SimulationError
     from gearbody.model import load_scenario
 
     try:
-        names = simulate(load_scenario(dict(base), [*overrides, f"operation.t_end_s={PROBE_S}"])).signals
+        record = simulate(load_scenario(dict(base), [*overrides, f"operation.t_end_s={PROBE_S}"])).record()
     except SimulationError:
         return  # the runs will say why
-    for name, spec in need.items():
-        if name not in names:
-            raise SweepSpecError(
-                f"--feature {spec}: the scene records no signal {name!r}; it records "
-                f"{', '.join(sorted(names))}"
-            )
+    for spec in specs:
+        try:
+            names = feature_signals(spec, record)
+        except FeatureError as exc:  # the feature does not apply to the stage it names
+            raise SweepSpecError(f"--feature {spec}: {str(exc).removeprefix(f'feature {spec}: ')}") from None
+        for name in names:
+            if name not in record.signals:
+                raise SweepSpecError(
+                    f"--feature {spec}: the scene records no signal {name!r}; it records "
+                    f"{', '.join(sorted(record.signals))}"
+                )
 
 
 def _check_rows(problem, base, overrides, X: np.ndarray) -> None:
