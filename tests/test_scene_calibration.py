@@ -147,6 +147,27 @@ def test_a_fit_writes_its_files_and_a_rerun_simulates_nothing(tmp_path, capsys):
     assert "0 simulations now" in capsys.readouterr().out and "residual/sigma" in first
 
 
+def test_a_fit_that_ends_on_its_bound_is_warned_about_and_flagged(tmp_path, capsys):
+    """A third natural frequency of 5000 Hz is out of reach of stiffnesses up to 1.5e9 N/m (2972 Hz there;
+    it rises with the stiffness): the fit ends on the upper bound, exits 0 (the fit is written), and says
+    so on stderr, in calibration.json and in calibration.md."""
+    out = tmp_path / "cal"
+    args = [
+        "calibrate", "one-stage", "--t-end", "0.02", *(x for o in STEADY for x in ("--set", o)),
+        "--param", f"{K}=0.9e9:1.5e9:log", "--target", "natural_frequency_hz:mode=3", "5000", "10",
+        "--budget", "3", "--polish-evaluations", "12", "--workers", "1", "--out", str(out),
+    ]  # fmt: skip
+    assert main(args) == 0
+    captured = capsys.readouterr()
+    (warning,) = [line for line in captured.err.splitlines() if "warning" in line]
+    assert warning.startswith(f"gearbody calibrate: warning: {K} = 1.5e+09 ends on its upper bound")
+    assert "on its upper bound" in captured.out  # the table's flag
+    record = json.loads((out / "calibration.json").read_text())
+    assert record["at_bound"] == {K: "upper"} and record["identified"] == {K: True}
+    assert record["warnings"] == [warning.removeprefix("gearbody calibrate: warning: ")]
+    assert "- warning: " + record["warnings"][0] in (out / "calibration.md").read_text()
+
+
 def test_another_scene_in_the_same_out_is_refused(tmp_path):
     out = tmp_path / "cal"
     kw = dict(
