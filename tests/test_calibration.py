@@ -207,3 +207,23 @@ def test_a_fit_that_ends_on_its_bounds_is_flagged_and_warned_about():
     assert any(w.startswith("p1 = ") and "ends on its lower bound (range [0.01, 10])" in w for w in warnings)
     assert "on its upper bound" in fit.table()
     assert fit.uncertainty_record()["at_bound"] == {"p0": "upper", "p1": "lower"}
+
+
+def _jittery(points):
+    """The line's features plus a jitter of +-0.01 sigma that changes on parameter scales far below 1e-3
+    of the box: what a simulated spectral line does under tiny parameter changes."""
+    out = Line()(points)
+    for p, features in zip(points, out, strict=True):
+        for i, key in enumerate(features):
+            features[key] += 0.01 * SIGMA * math.sin(1e5 * (p["p0"] + 3.0 * p["p1"]) + i)
+    return out
+
+
+def test_the_uncertainty_step_is_wide_enough_for_features_that_jitter():
+    """Steps of 1 % of the box keep the textbook sigma to 5 % despite the jitter; steps of 0.1 % (the
+    polish's) read the jitter as slope and miss it by more."""
+    expected = np.sqrt(np.diag(np.linalg.inv(A.T @ A))) * SIGMA
+    fit = calibrate(_jittery, PARAMETERS, TARGETS, budget=40, seed=3)
+    assert [fit.sigma["p0"], fit.sigma["p1"]] == pytest.approx(expected, rel=0.05)
+    narrow = calibrate(_jittery, PARAMETERS, TARGETS, budget=40, seed=3, uncertainty_step=1e-3)
+    assert [narrow.sigma["p0"], narrow.sigma["p1"]] != pytest.approx(expected, rel=0.05)

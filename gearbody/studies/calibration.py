@@ -65,6 +65,13 @@ unidentified."""
 NULL_COMPONENT = 1e-6
 """Largest component of a parameter in an exactly unidentified direction that is rounding, not a share."""
 
+UNCERTAINTY_STEP = 1e-2
+"""Forward-difference step (normalised coordinates: 1 % of the search box) of the Jacobian the
+uncertainty is computed from. Simulated features jitter under tiny parameter changes (a mesh line
+amplitude of one-stage by up to 9e-4 relative for a 1e-4 change of the mesh damping): divided by a
+step of 1e-3 that jitter outweighed the weakest parameter's true sensitivity and its sigma changed 30x
+between two fits at the same point; at 1e-2 it agrees with central differences of 1e-2 and 3e-2."""
+
 AT_BOUND_TOLERANCE = 1e-2
 """A fitted parameter closer than this fraction of its search box (normalised coordinates) to a bound
 ends on it: flagged in the result and warned about."""
@@ -364,10 +371,12 @@ def calibrate(
     seed: int = 0,
     cache: EvaluationCache | None = None,
     jacobian_step: float = 1e-3,
+    uncertainty_step: float = UNCERTAINTY_STEP,
 ) -> CalibrationResult:
     """Fit ``parameters`` to ``targets``: ``budget`` global evaluations (nevergrad, ``batch`` per
     round), then at most ``polish_evaluations`` in scipy's ``least_squares`` from the best point; the
-    uncertainty from the Jacobian (forward differences of ``jacobian_step`` in normalised coordinates).
+    uncertainty from the Jacobian at the optimum (forward differences of ``uncertainty_step`` in
+    normalised coordinates; the polish steps by ``jacobian_step``).
     Starting values (``Parameter.start``) are the optimiser's first point."""
     if not parameters:
         raise CalibrationError("no parameters to fit")
@@ -416,7 +425,7 @@ def calibrate(
         u_best = best["u"]
     # the Jacobian at the optimum, one batch, in normalised coordinates (columns of comparable size)
     r0 = run([u_best], "jacobian")[0]
-    steps = [u_best + _step(u_best, j, jacobian_step) for j in range(len(parameters))]
+    steps = [u_best + _step(u_best, j, uncertainty_step) for j in range(len(parameters))]
     rs = run(steps, "jacobian")
     values = point(u_best)
     J = np.empty((len(targets), len(parameters)))
