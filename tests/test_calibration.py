@@ -227,3 +227,16 @@ def test_the_uncertainty_step_is_wide_enough_for_features_that_jitter():
     assert [fit.sigma["p0"], fit.sigma["p1"]] == pytest.approx(expected, rel=0.05)
     narrow = calibrate(_jittery, PARAMETERS, TARGETS, budget=40, seed=3, uncertainty_step=1e-3)
     assert [narrow.sigma["p0"], narrow.sigma["p1"]] != pytest.approx(expected, rel=0.05)
+
+
+def test_a_parameter_no_target_sees_is_warned_about_once():
+    """p1 moves nothing: its direction is the p1 axis alone, said once as "p1 is not identified"."""
+
+    def flat(points):
+        return [{"y0": p["p0"], "y1": 2.0 * p["p0"]} for p in points]
+
+    fit = calibrate(flat, PARAMETERS, [Target("y0", 1.0, 0.1), Target("y1", 2.0, 0.1)], budget=20, seed=1)
+    assert fit.identified == {"p0": True, "p1": False} and len(fit.unidentified) == 1
+    assert [w for w in fit.warnings() if "not identified" in w or "direction" in w] == [
+        "p1 is not identified by the targets: its 1-sigma is wider than its range"
+    ]

@@ -286,7 +286,8 @@ class CalibrationResult:
         return {k: math.isfinite(v) for k, v in self.sigma.items()}
 
     def warnings(self) -> list[str]:
-        """One line per parameter that ends on a bound or is unidentified, and per unidentified direction."""
+        """One line per parameter that ends on a bound or is unidentified, and per unidentified direction
+        of two or more parameters."""
         lines = []
         for k, side in self.at_bound.items():
             lo, hi = self.bounds.get(k, (math.nan, math.nan))
@@ -299,6 +300,8 @@ class CalibrationResult:
             if not ok:
                 lines.append(f"{k} is not identified by the targets: its 1-sigma is wider than its range")
         for s, d in zip(self.unidentified_singular_values, self.unidentified, strict=True):
+            if sum(abs(v) > 1e-3 for v in d.values()) < 2:  # one key alone: said above
+                continue
             lines.append(
                 f"unidentified direction {_direction(d)} (normalised coordinates, singular value {s:.3g} < "
                 f"{IDENTIFIED_MIN_SINGULAR_VALUE:g}: its 1-sigma is wider than the range)"
