@@ -187,9 +187,10 @@ def test_the_paper_reproduction_writes_into_the_checkout_it_runs_from(monkeypatc
 
     checkout = Path(__file__).resolve().parents[1]
     monkeypatch.chdir(checkout)
-    assert common._output_dir() == checkout / "validation" / "paper"
-    monkeypatch.chdir(tmp_path)  # elsewhere: beside the installed scripts
-    assert common._output_dir() == Path(common.__file__).resolve().parent
+    assert common.resolve_output_dir() == checkout / "validation" / "paper"
+    monkeypatch.chdir(tmp_path)  # elsewhere: the current directory, never beside the installed scripts
+    assert common.resolve_output_dir() == tmp_path / common.DEFAULT_OUT
+    assert common.resolve_output_dir() != Path(common.__file__).resolve().parent
 
 
 def test_an_infeasible_drive_is_an_input_error_on_the_command_line(tmp_path, capsys):

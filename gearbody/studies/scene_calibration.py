@@ -13,8 +13,9 @@ The record in ``OUT``: ``evaluations.jsonl`` (every evaluation as it finishes: a
 command replays them and resumes an interrupted calibration; the features of a point do not depend on
 the targets' values, so a rerun with other target values or a larger budget reuses them),
 ``calibration.json`` and ``calibration.md`` (parameters, 1-sigma uncertainties, correlations, each
-target's residual, evaluations and wall time), ``convergence.png`` and ``calibrated.toml`` (the scene
-with the fitted values and the fixed overrides set: ``gearbody run OUT/calibrated.toml`` reruns it).
+target's residual, the parameters that end on a bound or are not identified, evaluations and wall
+time), ``convergence.png`` and ``calibrated.toml`` (the scene with the fitted values and the fixed
+overrides set: ``gearbody run OUT/calibrated.toml`` reruns it).
 """
 
 from __future__ import annotations
@@ -323,8 +324,7 @@ def _write_outputs(
             "overrides": list(overrides),
             "cases": {c: list(v) for c, v in cases.items()},
             "parameters": fit.parameters,
-            "sigma": fit.sigma,
-            "correlation": fit.correlation.tolist(),
+            **fit.uncertainty_record(),  # sigma (null: unidentified), correlation, flags, warnings
             "targets": [
                 {"feature": t.feature, "case": t.case, "value": t.value, "sigma": t.sigma}
                 for t in fit.targets
@@ -340,9 +340,11 @@ def _write_outputs(
             "history": fit.history,
         },
     )
+    warnings = "".join(f"- warning: {w}\n" for w in fit.warnings())
     text = (
         f"# Calibration of {label}\n\n```\n{fit.table()}\n```\n\n"
-        f"{stats['simulations']} simulations in this run, {wall:.1f} s wall; "
+        + (f"{warnings}\n" if warnings else "")
+        + f"{stats['simulations']} simulations in this run, {wall:.1f} s wall; "
         f"cases: {', '.join(repr(c) for c in cases if c) or 'the scene only'}. "
         f"Rerun the fitted scene: `gearbody run {out / 'calibrated.toml'}`.\n"
     )

@@ -5,12 +5,10 @@ shaft, machine), rated speed and load, steady running, friction as in the scene.
 grows linearly with e up to a threshold e that depends on a; above it the running is unstable
 (tooth separation, K_d > 2).
 
-    python -m gearbody_validation.paper.fig_09 [--quick]
+    python -m gearbody_validation.paper.fig_09 [--out DIR [--quick]]
 """
 
 from __future__ import annotations
-
-import argparse
 
 import numpy as np
 
@@ -19,7 +17,7 @@ from gearbody.model import load_scenario
 from gearbody.plotting import new_figure, save_figure
 from gearbody.studies import steady_overrides
 
-from .common import RESULTS_DIR, Claim, Timer, write_results
+from .common import Claim, Timer, check_quick, parser, results_dir, start, write_results
 
 SETTLE_S, RECORD_S = 0.1, 0.1
 MODES = {"a: E(0.1, e, 0)": (0.1, 1.0), "b: E(0.5, e, 0)": (0.5, 1.0), "c: E(0.5, -e, 0)": (0.5, -1.0)}
@@ -63,6 +61,7 @@ def curves_of(scene: str, e_values: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def main(quick: bool = False) -> None:
+    check_quick(quick)
     e_values = e_grid(quick)
     with Timer() as timer:
         curves = curves_of("one-stage", e_values)
@@ -75,11 +74,12 @@ def main(quick: bool = False) -> None:
     ax.set_title("one-stage, C_1 = 0, r = 0: K_d against the error e")
     ax.grid(alpha=0.3)
     ax.legend()
-    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    figs = [save_figure(fig, RESULTS_DIR / "fig_09_kd_vs_e.png", 100)]
+    results_dir().mkdir(parents=True, exist_ok=True)
+    figs = [save_figure(fig, results_dir() / "fig_09_kd_vs_e.png", 100)]
     e_list = ", ".join(f"{e:.0f}" for e in e_values)
     notes.append(f"e values {e_list} um; settle {SETTLE_S} s, record {RECORD_S} s.")
-    write_results("fig_09", "Fig. 9: K_d against the error e", claims, notes, figs, timer.s)
+    title = "Fig. 9: K_d against the error e"
+    write_results("fig_09", title, claims, notes, figs, timer.s, quick)
 
 
 def check(curves: dict[str, np.ndarray], e_values: np.ndarray, ax=None) -> tuple[list[Claim], list[str]]:
@@ -134,6 +134,6 @@ def check(curves: dict[str, np.ndarray], e_values: np.ndarray, ax=None) -> tuple
 
 
 if __name__ == "__main__":
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true", help="fewer e values")
-    main(p.parse_args().quick)
+    args = parser(__doc__, "fewer e values").parse_args()
+    start("fig_09", args)
+    main(args.quick)

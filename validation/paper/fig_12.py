@@ -5,12 +5,10 @@ System: the shipped `one-stage` scene as it is (its operation section is the fou
 0-0.5 s, no load to 0.8 s, load ramp to 1.2 s, rated load to 2.0 s); only the error mode and the
 coupling damping C_1 change per case, as in the paper.
 
-    python -m gearbody_validation.paper.fig_12 [--quick]
+    python -m gearbody_validation.paper.fig_12 [--out DIR [--quick]]
 """
 
 from __future__ import annotations
-
-import argparse
 
 import numpy as np
 
@@ -18,7 +16,7 @@ from gearbody.engine import simulate
 from gearbody.model import load_scenario
 from gearbody.plotting import new_figure, save_figure
 
-from .common import RESULTS_DIR, Claim, Timer, write_results
+from .common import Claim, Timer, check_quick, parser, results_dir, start, write_results
 
 # label: (a, e_um, r, C_1 N m s, the paper's K_d in period 4 or its verdict)
 CASES = {
@@ -48,6 +46,7 @@ def run(a, e, r, c1, t_end):
 
 
 def main(quick: bool = False) -> None:
+    check_quick(quick)
     t_end = 1.6 if quick else 2.0
     kd4, traces = {}, {}
     with Timer() as timer:
@@ -66,8 +65,8 @@ def main(quick: bool = False) -> None:
         ax.set_title(f"{label}: K_d4 = {kd4[label]:.2f} (paper {CASES[label][4]})", fontsize=9)
         ax.set_xlabel("t [s]", fontsize=8)
         ax.set_ylabel("K_d", fontsize=8)
-    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    figs = [save_figure(fig, RESULTS_DIR / "fig_12_runs.png", 100)]
+    results_dir().mkdir(parents=True, exist_ok=True)
+    figs = [save_figure(fig, results_dir() / "fig_12_runs.png", 100)]
     k = list(kd4.values())
     claims = []
     for label, (*_, paper) in CASES.items():
@@ -119,10 +118,11 @@ def main(quick: bool = False) -> None:
         "The paper's parameter set is not published; ours puts the mesh mode (2844 Hz) far above the "
         "rated mesh frequency (494 Hz), so absolute K_d values are lower than the paper's. Nothing tuned.",
     ]
-    write_results("fig_12", "Fig. 12: four-period runs, K_d in period 4", claims, notes, figs, timer.s)
+    title = "Fig. 12: four-period runs, K_d in period 4"
+    write_results("fig_12", title, claims, notes, figs, timer.s, quick)
 
 
 if __name__ == "__main__":
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true", help="period 4 shortened to 0.4 s")
-    main(p.parse_args().quick)
+    args = parser(__doc__, "period 4 shortened to 0.4 s").parse_args()
+    start("fig_12", args)
+    main(args.quick)

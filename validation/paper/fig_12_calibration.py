@@ -31,20 +31,22 @@ Pre-registered (written before any fitting run, issue 18 deliverable 4):
   it scales the rated torque, the breakdown torque and the rotor inertia). Its scene is
   `one-stage-calibrated-rating`; both are reported (validation/paper/RESULTS.md, "Calibrated drive").
 
-    python -m gearbody_validation.paper.fig_12_calibration [--screen] [--calibrate [--fit rating]] [--quick]
+    python -m gearbody_validation.paper.fig_12_calibration [--screen] [--calibrate [--fit rating]]
+        [--out DIR [--quick]]
 
 Without a flag the script reads the calibration records (results/fig_12_calibration*/) and runs the
 predictions on the scenes they wrote (fig_12_predictions.py); `--calibrate` reruns a fit (it replays
 its evaluation record, so a finished fit costs no simulation, an interrupted one resumes) and rewrites
-its scene; `--screen` reruns the screening. Calibration: 160 global evaluations (nevergrad TwoPointsDE,
-2 points per round, each point = the two fit cases on 2 worker processes), <= 40 in the least-squares
-polish, then the Jacobian (~9 min wall on 2 cores).
+its scene (into the checkout's scenes/, or DIR/scenes with --out); `--screen` reruns the screening.
+Calibration: 160 global evaluations (nevergrad TwoPointsDE, 2 points per round, each point = the two
+fit cases on 2 worker processes), <= 40 in the least-squares polish, then the Jacobian (~9 min wall on
+2 cores).
 """
 
 from __future__ import annotations
 
-import argparse
 import json
+import sys
 import textwrap
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -53,12 +55,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import RESULTS_DIR
+from .common import check_quick, is_record, output_dir, parser, results_dir, start
 from .fig_12 import CASES, PERIOD_4_S
 
 SCENE = "one-stage"
 CALIBRATED_SCENE = "one-stage-calibrated"
-RECORD_DIR = RESULTS_DIR / "fig_12_calibration"  # the pre-registered fit's record (and the screening)
 WORKERS = 2
 FIT_CASES = {"(a) E(0.5,12,0.3) C1=0": 1.8, "(d) E(0.5,20,0.3) C1=1000": 2.4}
 FIT_SIGMA = 0.1
@@ -173,7 +174,17 @@ class Fit:
 
     @property
     def record_dir(self) -> Path:
-        return RESULTS_DIR / self.name
+        """Where --calibrate writes this fit's record: results/<name> of the output folder."""
+        return results_dir() / self.name
+
+    def record_file(self) -> Path | None:
+        """This fit's calibration.json: in the output folder, else in the record of the checkout this
+        package lies in; None if neither has one."""
+        for folder in (results_dir(), Path(__file__).resolve().parent / "results"):
+            path = folder / self.name / "calibration.json"
+            if path.is_file():
+                return path
+        return None
 
 
 FITS = {
@@ -295,6 +306,19 @@ def identifiability(cache, params, tg, best: dict[str, float]) -> dict:
     }
 
 
+def _uncertainty(result) -> dict:
+    """The fit's own uncertainty as the record stores it: sigma per parameter (None: not identified by
+    the targets), correlation, the unidentified directions and the parameters on a bound."""
+    u = result.uncertainty_record()
+    return {
+        "sigma_parameters": u["sigma"],
+        "correlation": u["correlation"],
+        "unidentified_directions": u["unidentified_directions"],
+        "at_bound": u["at_bound"],
+        "warnings": u["warnings"],
+    }
+
+
 def run_calibration(fit: Fit) -> dict:
     """Fit `fit.fitted` to FIT_CASES (resumes from its evaluations.jsonl); writes calibration.json."""
     from gearbody.model.scenes import scene_path
@@ -341,8 +365,7 @@ def run_calibration(fit: Fit) -> dict:
         "targets": FIT_CASES,
         "sigma": FIT_SIGMA,
         "parameters": result.parameters,
-        "sigma_parameters": result.sigma,
-        "correlation": np.asarray(result.correlation).tolist(),
+        **_uncertainty(result),
         "features": result.features,
         "residuals": result.residuals,
         "cost": result.cost,
@@ -362,7 +385,8 @@ def run_calibration(fit: Fit) -> dict:
     }
     previous = record_dir / "calibration.json"
     if previous.exists() and result.replayed:  # a resumed run: the wall time of the first one counts too
-        record["wall_s_total"] = json.loads(previous.read_text()).get("wall_s_total", 0.0) + wall
+        before = json.loads(previous.read_text()).get("wall_s_total", 0.0)
+        record["wall_s_total"] = before + (wall if evaluator.runs else 0.0)  # a pure replay adds none
     else:
         record["wall_s_total"] = wall
     (record_dir / "calibration.json").write_text(json.dumps(record, indent=1))
@@ -385,8 +409,9 @@ def screen() -> dict:
         ka, kd = kds[2 * n], kds[2 * n + 1]
         out["rows"].append({"point": name, "values": p, "kd4_a": ka, "kd4_d": kd})
         print(f"{name:55s} (a) {ka}  (d) {kd}")
-    RECORD_DIR.mkdir(parents=True, exist_ok=True)
-    (RECORD_DIR / "screening.json").write_text(json.dumps(out, indent=1))
+    folder = FITS["fig3"].record_dir
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "screening.json").write_text(json.dumps(out, indent=1))
     return out
 
 
@@ -477,15 +502,23 @@ def scene_text(fit: Fit, record: dict) -> str:
     return header + "\n" + "\n".join(out) + "\n"
 
 
-def write_scene(fit: Fit, record: dict) -> Path:
-    from gearbody.model.scenes import scene_dir
+def scene_folder() -> Path:
+    """Where --calibrate writes a fit's scene: the checkout's scenes/ when the output is its record, else
+    ``scenes/`` of the output folder (never an installed package)."""
+    out = output_dir()
+    return out.parents[1] / "scenes" if is_record(out) else out / "scenes"
 
-    path = scene_dir() / f"{fit.scene}.toml"
+
+def write_scene(fit: Fit, record: dict) -> Path:
+    path = scene_folder() / f"{fit.scene}.toml"
+    path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(scene_text(fit, record))
+    print(f"wrote {path}")
     return path
 
 
 def main(quick: bool = False, do_screen: bool = False, do_calibrate: bool = False, fit: str = "fig3") -> None:
+    check_quick(quick)
     if do_screen:
         screen()
         return
@@ -498,10 +531,16 @@ def main(quick: bool = False, do_screen: bool = False, do_calibrate: bool = Fals
 
 
 if __name__ == "__main__":
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = parser(__doc__, "fewer prediction runs")
     p.add_argument("--screen", action="store_true", help="one-at-a-time screening of the bounded parameters")
     p.add_argument("--calibrate", action="store_true", help="run (or resume) the calibration")
-    p.add_argument("--quick", action="store_true", help="fewer prediction runs")
     p.add_argument("--fit", choices=sorted(FITS), default="fig3", help="which calibration (default fig3)")
     a = p.parse_args()
-    main(a.quick, a.screen, a.calibrate, a.fit)
+    start("fig_12_calibration", a)
+    from gearbody.studies.calibration import CalibrationError
+
+    try:
+        main(a.quick, a.screen, a.calibrate, a.fit)
+    except CalibrationError as exc:  # e.g. a record of the fit on another scene file
+        print(f"fig_12_calibration: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None

@@ -21,7 +21,7 @@ from gearbody.model import load_scenario
 from gearbody.plotting import new_figure, save_figure
 
 from . import fig_09, figs_13_16
-from .common import RESULTS_DIR, Claim, Timer
+from .common import QUICK_LABEL, Claim, Timer, check_quick, results_dir
 from .faults import tooth_run
 from .fig_12 import CASES, RESOLVED_KD_CHANGE
 from .fig_12_calibration import BOUND, FIT_CASES, FIT_SIGMA, FITS, Fit, case_overrides, run_batch
@@ -152,11 +152,15 @@ def _mesh_damping_ratio(scene: str) -> tuple[float, float, list[float]]:
     return float(zeta), float(m), [float(f) for f in scene_modes(sc).frequencies_hz]
 
 
-def _table(claims: list[Claim]) -> list[str]:
+def _result(c: Claim, quick: bool) -> str:
+    return ("PASS" if c.passed else "FAIL") + (" (quick)" if quick else "")
+
+
+def _table(claims: list[Claim], quick: bool = False) -> list[str]:
     lines = ["| figure | claim | measured | result |", "|---|---|---|---|"]
     for c in claims:
         note = f" ({c.note})" if c.note else ""
-        lines.append(f"| {c.figure} | {c.claim} | {c.measured} | {'PASS' if c.passed else 'FAIL'}{note} |")
+        lines.append(f"| {c.figure} | {c.claim} | {c.measured} | {_result(c, quick)}{note} |")
     return lines
 
 
@@ -194,14 +198,14 @@ def predict_fit(fit: Fit, record: dict, quick: bool = False) -> tuple[list, list
     zeta, m_red, modes = _mesh_damping_ratio(fit.scene)
     damping_check = _damping_check(fit.scene, zeta) if zeta < ZETA_RANGE[0] else None
     scatter = seed_scatter(fit.scene)
-    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
+    results_dir().mkdir(parents=True, exist_ok=True)
     fig = _plot(
         kd,
         further,
-        RESULTS_DIR / f"{fit.name}_kd4.png",
+        results_dir() / f"{fit.name}_kd4.png",
         f"{fit.scene}: Fig. 12 cases (bars) and the paper's values (red)",
     )
-    lines = _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, timer.s, fig)
+    lines = _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, timer.s, fig, quick)
     at = lines.index("#### Fitted claims (used in the fit: not evidence)")
     lines[at:at] = [
         f"Seed scatter of the fit cases (error-mode seeds {', '.join(map(str, SCATTER_SEEDS))}, "
@@ -226,18 +230,20 @@ def predict_fit(fit: Fit, record: dict, quick: bool = False) -> tuple[list, list
             "",
         ]
     for c in fitted + predicted:
-        print(f"[{'PASS' if c.passed else 'FAIL'}] {c.figure}: {c.claim} -- {c.measured}")
+        print(f"[{_result(c, quick)}] {c.figure}: {c.claim} -- {c.measured}")
     return lines, fitted, predicted, {**kd, **further}
 
 
 def predict(quick: bool = False) -> None:
     """Predictions of every fit with a record; writes results/fig_12_calibration.md/.json (the
-    pre-registered fit's predicted claims are the `claims` that run_all counts)."""
-    data: dict = {"title": "Calibrated drive", "wall_s": 0.0}
+    pre-registered fit's predicted claims are the `claims` that run_all counts); a quick run says so in
+    the title, every result and ``"quick": true``."""
+    check_quick(quick)
+    data: dict = {"title": "Calibrated drive", "wall_s": 0.0, "quick": quick}
     bodies, summary, kds = [], [], {}
     for key, fit in FITS.items():
-        path = fit.record_dir / "calibration.json"
-        if not path.exists():
+        path = fit.record_file()
+        if path is None:
             continue
         record = json.loads(path.read_text())
         with Timer() as timer:
@@ -259,7 +265,8 @@ def predict(quick: bool = False) -> None:
             f"{sum(c.passed for c in n12)} / {len(n12)} |"
         )
     parts = [
-        "## Calibrated drive: Fig. 12 by calibration, the other claims as predictions",
+        "## Calibrated drive: Fig. 12 by calibration, the other claims as predictions"
+        + (f" ({QUICK_LABEL})" if quick else ""),
         "",
         "| scene | fitted | (a) K_d4 fitted (paper) | (d) K_d4 fitted (paper) | chi^2/2 | predicted claims "
         "passed | of them Fig. 12 |",
@@ -269,8 +276,8 @@ def predict(quick: bool = False) -> None:
     ]
     need_lines, need_kd = needs()
     parts += [*_reading(kds, need_kd), "", *bodies, *need_lines]
-    (RESULTS_DIR / f"{NAME}.md").write_text("\n".join(parts))
-    (RESULTS_DIR / f"{NAME}.json").write_text(json.dumps(data, indent=2))
+    (results_dir() / f"{NAME}.md").write_text("\n".join(parts))
+    (results_dir() / f"{NAME}.json").write_text(json.dumps(data, indent=2))
 
 
 def _within(v: float | None, paper: str) -> bool:
@@ -326,7 +333,29 @@ def _reading(kds: dict[str, dict], need_kd: dict[str, float | None]) -> list[str
     return out
 
 
-def _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, predict_s, fig) -> list[str]:
+def _own_sigma(fit, record: dict) -> str:
+    """What gearbody's CalibrationResult says of the same Jacobian: each parameter's 1-sigma, or that it
+    is not identified (a record written before the uncertainty reported unidentified parameters: no
+    statement, its pseudo-inverse sigmas dropped directions)."""
+    if "unidentified_directions" not in record:
+        return ""
+    sigma = record["sigma_parameters"]
+    free = [k for k in fit.fitted if sigma.get(k) is None]
+    if len(free) == len(fit.fitted):
+        return f" (gearbody's CalibrationResult: none of the {len(free)} parameters is identified on its own)"
+    return (
+        " (gearbody's CalibrationResult: 1-sigma "
+        + ", ".join(
+            f"`{k}` {'not identified' if sigma.get(k) is None else format(sigma[k], '.2g')}"
+            for k in fit.fitted
+        )
+        + ")"
+    )
+
+
+def _markdown(
+    fit, record, fitted, predicted, notes9, zeta, m_red, modes, predict_s, fig, quick=False
+) -> list[str]:
     n_pass = sum(c.passed for c in predicted)
     lines = [
         f"### {fit.scene}",
@@ -368,17 +397,17 @@ def _markdown(fit, record, fitted, predicted, notes9, zeta, m_red, modes, predic
         f"{len(fit.fitted)} parameters (singular values in normalised coordinates "
         + ", ".join(f"{x:.3g}" for x in record["singular_values_unit"])
         + "): the values are one point of a family that fits as well; the conditional sigma holds the "
-        "others at the optimum (the Jacobian pseudo-inverse of gearbody's CalibrationResult gives "
-        + ", ".join(f"{record['sigma_parameters'][k]:.2g}" for k in fit.fitted)
-        + ")."
+        "others at the optimum"
+        + _own_sigma(fit, record)
+        + "."
         + (f" At a bound: {', '.join(active)}." if active else ""),
         "",
         f"Mesh damping ratio at the optimum {zeta:.3f} of critical (reduced mass {m_red:.1f} kg); natural "
         "frequencies (C_1 = 0) " + ", ".join(f"{f:.1f}" for f in modes) + " Hz; mesh frequency 494 Hz.",
         "",
     ]
-    lines += ["#### Fitted claims (used in the fit: not evidence)", "", *_table(fitted), ""]
-    lines += [f"#### Predicted claims: {n_pass} / {len(predicted)} pass", "", *_table(predicted), ""]
+    lines += ["#### Fitted claims (used in the fit: not evidence)", "", *_table(fitted, quick), ""]
+    lines += [f"#### Predicted claims: {n_pass} / {len(predicted)} pass", "", *_table(predicted, quick), ""]
     lines += [f"- {n}" for n in notes9]
     lines += [
         "- Figs. 6-8 are results of the two-wheel model of the paper's ref. [13] (Fig. 2, no motor or "

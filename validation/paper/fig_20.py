@@ -19,7 +19,7 @@ from gearbody.model import load_scenario, scenario_to_dict
 from gearbody.plotting import new_figure, save_figure
 from gearbody.studies import steady_overrides
 
-from .common import RESULTS_DIR, Claim, Timer, write_results
+from .common import Claim, Timer, parser, results_dir, start, write_results
 
 SETTLE_S, RECORD_S = 0.3, 2.0
 SIGNAL = "wheel_accel_rad_s2"
@@ -81,8 +81,8 @@ def main() -> None:
         ax.set_title(f"two-stage, {SIGNAL}: {title}", fontsize=9)
         ax.set_ylabel("rad/s^2")
     ax.set_xlabel("frequency [Hz]")
-    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    figs = [save_figure(fig, RESULTS_DIR / "fig_20_spectrum.png", 100)]
+    results_dir().mkdir(parents=True, exist_ok=True)
+    figs = [save_figure(fig, results_dir() / "fig_20_spectrum.png", 100)]
     claims = []
     res_hz = sp.resolution_hz
     for label in ("f_z1-f_z2", "f_z1+f_z2", "2f_z1-f_z2", "2f_z1+f_z2", "f_z1-2f_z2", "f_z1+2f_z2"):
@@ -110,4 +110,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    start("fig_20", parser(__doc__).parse_args())
     main()

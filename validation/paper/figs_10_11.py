@@ -15,7 +15,7 @@ import numpy as np
 from gearbody.analysis import condition_indicators_from_average, synchronous_average
 from gearbody.plotting import new_figure, save_figure
 
-from .common import RESULTS_DIR, Claim, Timer, write_results
+from .common import Claim, Timer, parser, results_dir, start, write_results
 from .faults import BROKEN_TOOTH, tooth_run
 
 RECORD_S = 1.0
@@ -51,8 +51,8 @@ def main() -> None:
     ax.set_title(title, fontsize=9)
     ax.set_xlabel("pinion angle [deg]")
     ax.legend(fontsize=8)
-    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
-    figs = [save_figure(fig, RESULTS_DIR / "figs_10_11_tsa.png", 100)]
+    results_dir().mkdir(parents=True, exist_ok=True)
+    figs = [save_figure(fig, results_dir() / "figs_10_11_tsa.png", 100)]
     fm4_b = ind["broken tooth (0.2 k_z)"]["fm4"]
     rms_h = float(np.std(tsa["healthy"].difference()))
     rms_b = float(np.std(diff))
@@ -89,4 +89,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    start("figs_10_11", parser(__doc__).parse_args())
     main()

@@ -22,7 +22,7 @@ from gearbody.analysis import amplitude_spectrum
 from gearbody.engine import SimulationError
 from gearbody.plotting import new_figure, save_figure
 
-from .common import RESULTS_DIR, Claim, Timer, write_results
+from .common import Claim, Timer, parser, results_dir, start, write_results
 from .faults import GEOMETRIC_DAMAGE, damaged_tooth_run, tooth_run
 
 FACTORS = (None, 0.8, 0.6, 0.2, 0.0)
@@ -129,10 +129,10 @@ def main() -> None:
             geometry_runs[label] = lambda d=damage: damaged_tooth_run(d, RECORD_S)
         spectra, wideband, share, lines, failed = run_series(factor_runs)
         g_spectra, g_wideband, g_share, g_lines, g_failed = run_series(geometry_runs)
-    RESULTS_DIR.mkdir(parents=True, exist_ok=True)
+    results_dir().mkdir(parents=True, exist_ok=True)
     figs = [
-        _plot(spectra, wideband, lines, RESULTS_DIR / "figs_13_16_spectra.png"),
-        _plot(g_spectra, g_wideband, g_lines, RESULTS_DIR / "figs_13_16_geometry_spectra.png"),
+        _plot(spectra, wideband, lines, results_dir() / "figs_13_16_spectra.png"),
+        _plot(g_spectra, g_wideband, g_lines, results_dir() / "figs_13_16_geometry_spectra.png"),
     ]
     claims = _claims("factors (one-stage)", wideband, share, lines, failed)
     claims += _claims("damage by geometry (one-stage-geometry)", g_wideband, g_share, g_lines, g_failed)
@@ -151,4 +151,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    start("figs_13_16", parser(__doc__).parse_args())
     main()
