@@ -12,8 +12,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_import_contracts_hold():
-    exe = shutil.which("lint-imports") or str(Path(sys.executable).with_name("lint-imports"))
-    if not Path(exe).exists():
+    # the interpreter's own lint-imports first: another one on PATH (a pyenv shim) may lack the package
+    own = Path(sys.executable).with_name("lint-imports")
+    exe = str(own) if own.exists() else shutil.which("lint-imports")
+    if exe is None or not Path(exe).exists():
         pytest.skip("import-linter is not installed (pip install '.[test]')")
     run = subprocess.run([exe, "--config", str(ROOT / "pyproject.toml")], capture_output=True, text=True)
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
