@@ -260,7 +260,7 @@ def test_agrees_with_brute_force_literal_integration_with_faults():
         p1, p2, p3, p4, w1, w2, w3, w4 = y
         mesh = ref.mesh_force_literal(sc, p2 * 29 / (2 * math.pi), r1 * p2 - r2 * p3, r1 * w2 - r2 * w3)
         F = float(mesh["F"])
-        fr = ref.friction_moments(sc, mesh["p"], F)
+        fr = ref.friction_moments(sc, mesh["p"], F, w2, w3)
         ms = float(ref.kloss_torque(w1, mot["synchronous_speed_rad_s"], mot))
         m1, m2 = k1 * (p1 - p2), k2 * (p3 - p4)
         return [

@@ -249,23 +249,33 @@ def test_steady_start_stays_at_rest_in_the_rotating_frame(variant):
 
 
 def test_friction_direction_and_fixed_direction_signal():
-    """mu > 0, paper geometry: the x force on the pinion is T m_x = -mu |F| s (s = +1 before the pitch
-    point), on the wheel +mu |F| s; with lateral 'y' the x bearing signal is that mesh component."""
+    """mu > 0, paper geometry: T = -mu |F| sigma(v_sl / v_0) with the centres' velocities in v_sl (the
+    literal law on the returned states; T > 0 before the pitch point in forward running), the x force
+    on the pinion is T m_x = -T, on the wheel +T; with lateral 'y' the x bearing signal is that mesh
+    component; the friction power T v_sl is <= 0 at every sample."""
     sc = scene("lateral-6dof", 0.004)
     mu = sc["condition"]["friction_coefficient"]
     assert mu > 0
     res = lat.simulate_reference_lateral(sc)
-    q = res["coordinates"]
+    q, v = res["coordinates"], res["velocities"]
     p = np.mod(q[1] * sc["design"]["pinion"]["teeth"] / (2 * math.pi), 1.0)
-    s = np.where(p < sc["design"]["mesh"]["pitch_point_phase"], 1.0, -1.0)
     F = res["mesh_force_N"]
-    np.testing.assert_allclose(res["stage_friction_force_N"][0], mu * np.abs(F) * s, rtol=1e-12)
+    m = lat.mesh_geometry(sc["design"]["mesh"])["m"]
+    v_c = m @ (res["centre_velocity_m_s"]["pinion"] - res["centre_velocity_m_s"]["wheel"])
+    fr = ref.friction_moments(sc, p, F, v[1], v[2], v_c)
+    T = res["stage_friction_force_N"][0]
+    np.testing.assert_allclose(T, fr["T"], rtol=0, atol=1e-9 * np.abs(F).max())
+    fast = np.abs(fr["v_sl"]) >= 0.01  # full sliding: the force of the phase-only law of earlier versions
+    s = np.where(p < sc["design"]["mesh"]["pitch_point_phase"], 1.0, -1.0)
+    np.testing.assert_array_equal(T[fast], (mu * np.abs(F) * s)[fast])
+    assert np.mean(fast) > 0.9
+    assert np.all(T * fr["v_sl"] <= 0.0)
     fx_pinion = res["mesh_force_on_centre_N"]["pinion"][0]
-    np.testing.assert_allclose(fx_pinion, -mu * np.abs(F) * s, rtol=0, atol=1e-9 * np.abs(F).max())
+    np.testing.assert_allclose(fx_pinion, -T, rtol=0, atol=1e-9 * np.abs(F).max())
     np.testing.assert_allclose(res["mesh_force_on_centre_N"]["wheel"][0], -fx_pinion, rtol=1e-12)
     np.testing.assert_array_equal(res["bearing_force_N"]["pinion"][0], fx_pinion)  # x held fixed
     np.testing.assert_array_equal(res["centre_displacement_m"]["pinion"][0], 0.0)
-    assert np.any(s > 0) and np.any(s < 0)
+    assert np.any(T > 0) and np.any(T < 0)
     # y: the wheel pushes the pinion towards +y
     np.testing.assert_allclose(res["mesh_force_on_centre_N"]["pinion"][1], F, rtol=1e-12)
 
@@ -317,7 +327,7 @@ def _literal_rhs(sc: dict):
             r1 * w[1] - r2 * w[2] + (vp - vw) @ n,
         )
         F = float(lit["F"])
-        fr = ref.friction_moments(sc, lit["p"], F)
+        fr = ref.friction_moments(sc, lit["p"], F, w[1], w[2], (vp - vw) @ m)
         T = float(fr["T"])
         ws = mot["synchronous_speed_rad_s"] * ref.profile_value(t, op["speed_profile"])
         Ms = float(ref.kloss_torque(w[0], ws, mot))

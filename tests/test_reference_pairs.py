@@ -173,8 +173,11 @@ def test_break_points_include_the_grid_points():
     # 0, h, 1 - h, apex a = 0.5 = pitch point, and the grid points q_m mod 1: 0.8, 0.15, 0.5, 0.85, 0.2
     np.testing.assert_allclose(sharp, [0.0, 0.15, 0.2, 0.5, 0.8, 0.85], rtol=0, atol=1e-12)
     smooth = ref.phase_breakpoints(hand_scenario(W))
-    for x in (0.15, 0.85, 0.15, 0.25, 0.75, 0.85, 0.05, 0.95, 0.45, 0.55):  # grid, ramp ends h -+ w/2, ...
+    for x in (0.15, 0.85, 0.15, 0.25, 0.75, 0.85, 0.05, 0.95):  # grid, ramp ends h -+ w/2, tooth change
         assert np.min(np.abs(smooth - x)) < 1e-12
+    # no ramp at the pitch point: friction's direction follows the sliding velocity, not the phase
+    for x in (0.45, 0.55):
+        assert np.min(np.abs(smooth - x)) > 0.01
 
 
 def test_iso_6336_b_is_the_contact_ratio_law_and_limits_hold_for_all_but_table():

@@ -123,7 +123,7 @@ def test_static_load_sharing_and_reactions():
     q = st.static_equilibrium(np.array([T, 0.0, -T * (1.0 + rb)]))
     z = np.zeros(st.n_dof)
     modes = st.mesh_modes(q, z)
-    mcs = [law.mode_consts(*m) for law, m in zip(st.meshes, modes, strict=True)]
+    mcs = [law.mode_consts(*m[:3]) for law, m in zip(st.meshes, modes, strict=True)]  # m = [n, k, c, g]
     geo = st.mesh_geometry(q, z)
     F = st.mesh_forces(geo, mcs, modes)
     F0 = T / (st.N * st.r_bs)
@@ -359,7 +359,7 @@ def test_static_sharing_with_tooth_errors():
     q = st.static_equilibrium(np.array([T, 0.0, -T * (1.0 + rb)]), theta_gauge=0.05)
     z = np.zeros(st.n_dof)
     modes = st.mesh_modes(q, z)
-    mcs = [law.mode_consts(*m) for law, m in zip(st.meshes, modes, strict=True)]
+    mcs = [law.mode_consts(*m[:3]) for law, m in zip(st.meshes, modes, strict=True)]  # m = [n, k, c, g]
     F = st.mesh_forces(st.mesh_geometry(q, z), mcs, modes)
     assert sum(F["sun"]) * st.r_bs == pytest.approx(T, rel=1e-9)
     assert sum(F["ring"]) * st.r_br == pytest.approx(T * rb, rel=1e-9)

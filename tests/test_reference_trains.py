@@ -278,7 +278,7 @@ def _literal_train_rhs(sc: dict):
             u = q[ip] * view["design"]["pinion"]["teeth"] / (2 * math.pi)
             m = ref.mesh_force_literal(view, u, r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw])
             F = float(m["F"])
-            fr = ref.friction_moments(view, m["p"], F)
+            fr = ref.friction_moments(view, m["p"], F, v[ip], v[iw])
             moment[ip] = S[s] - r1 * F + float(fr["M_zt1"])
             moment[iw] = r2 * F - float(fr["M_zt2"]) - S[s + 1]
         moment[-1] = S[N] - d["machine"]["rated_torque_Nm"] * ref.profile_value(t, op["load_profile"])

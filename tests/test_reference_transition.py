@@ -35,18 +35,25 @@ def scenario(w: float = W, **changes) -> dict:
     return sc
 
 
-def locked_law(sc: dict, u: np.ndarray, delta, delta_dot, c: int = 1):
-    """Force, error and mu s of the locked-mode law (what the integrator uses) at mesh coordinates u."""
+def locked_law(sc: dict, u: np.ndarray, delta, delta_dot, c: int = 1, w_p=None, w_w=None):
+    """Force, error and mu e (friction's magnitude without |F|) of the locked-mode law (what the integrator
+    uses) at mesh coordinates u; given the speeds w_p, w_w also the friction force T (slide mode of the
+    sliding velocity, as the integrator classifies it)."""
     mesh = ref._Mesh(sc)
-    F, E, mus = (np.empty(u.size) for _ in range(3))
+    F, E, mue, T = (np.empty(u.size) for _ in range(4))
     for m, um in enumerate(u):
         n, k = mesh.phase_mode(float(um), 1.0)
         mc = mesh.mode_consts(n, k, c)
         p = float(um) - n
         F[m] = ref._mesh_force(mc, p, float(delta[m]), float(delta_dot[m]))
         E[m] = ref._mode_error(mc, p)
-        mus[m] = ref._mode_mu_sign(mesh, k, mc, p)
-    return F, E, mus
+        mue[m] = ref._mode_mu_envelope(mesh, mc, p)
+        if w_p is not None:
+            wp, ww = float(w_p[m]), float(w_w[m])
+            v_sl = ref._mode_friction(mesh, mc, 0, p, F[m], wp, ww)[3]
+            g = ref._slide_mode(v_sl * mesh.inv_v0)
+            T[m] = ref._mode_friction(mesh, mc, g, p, F[m], wp, ww)[0]
+    return (F, E, mue, T) if w_p is not None else (F, E, mue)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -95,30 +102,39 @@ def test_mean_stiffness_over_a_period_is_unchanged():
         assert mean == pytest.approx(sharp_mean, rel=1e-9)
 
 
-def test_friction_sign_zero_at_tooth_change_and_pitch_point():
+def test_friction_envelope_zero_at_tooth_change_and_one_elsewhere():
     ppp = 0.5
-    s = ref.friction_sign(np.array([0.0, ppp]), ppp, W)
-    np.testing.assert_array_equal(s, [0.0, 0.0])
-    before = np.linspace(W / 2, ppp - W / 2, 20)
-    after = np.linspace(ppp + W / 2, 1 - W / 2, 20)
-    np.testing.assert_array_equal(ref.friction_sign(before, ppp, W), 1.0)
-    np.testing.assert_array_equal(ref.friction_sign(after, ppp, W), -1.0)
-    # ramps: down through 0 at the pitch point, up from -1 to 0 towards the tooth change, 0 to 1 after it
-    assert 0 < ref.friction_sign(ppp - W / 4, ppp, W) < 1 and -1 < ref.friction_sign(ppp + W / 4, ppp, W) < 0
-    assert -1 < ref.friction_sign(1 - W / 4, ppp, W) < 0 and 0 < ref.friction_sign(W / 4, ppp, W) < 1
-    assert ref.friction_sign(1 - 1e-12, ppp, W) == pytest.approx(0.0, abs=1e-9)
-    # pitch point 0 or 1: constant sign (as the sharp law); w = 0: the sharp law
-    np.testing.assert_array_equal(ref.friction_sign([0.0, 0.3, 0.99], 0.0, W), -1.0)
-    np.testing.assert_array_equal(ref.friction_sign([0.0, 0.3, 0.99], 1.0, W), 1.0)
-    np.testing.assert_array_equal(ref.friction_sign([0.0, 0.49, 0.5, 0.9], ppp, 0.0), [1, 1, -1, -1])
-    # T = mu |F| s in the literal helper and mu s in the locked-mode law
+    e = ref.friction_envelope
+    assert float(e(0.0, W)) == 0.0
+    np.testing.assert_array_equal(e(np.linspace(W / 2, 1 - W / 2, 41), W), 1.0)  # the pitch point too
+    # ramps: from 0 at the tooth change to 1 at w/2 after it, from 1 at w/2 before the next down to 0
+    s4 = float(ref.smooth_step(0.25))
+    assert float(e(W / 4, W)) == pytest.approx(2 * s4 - 1, rel=1e-14)
+    assert float(e(1 - W / 4, W)) == pytest.approx(2 * s4 - 1, rel=1e-14)  # 1 - 2 S(-1/4)
+    assert 0 < 2 * s4 - 1 < 1
+    assert float(e(1 - 1e-12, W)) == pytest.approx(0.0, abs=1e-9)
+    ramp = e(np.linspace(0.0, W / 2, 11), W)
+    assert np.all(np.diff(ramp) > 0)
+    np.testing.assert_array_equal(e([0.0, 0.3, 0.99], 0.0), 1.0)  # w = 0: the sharp law
+    # T = -mu |F| e sigma(v_sl / v_0) in the literal helper: forward rolling (r1 w_p = r2 w_w), back flank
     sc = scenario()
     mu = sc["condition"]["friction_coefficient"]
-    fr = ref.friction_moments(sc, np.array([0.0, ppp, 0.2, 0.8]), -2.0)
-    np.testing.assert_allclose(fr["T"], [0.0, 0.0, 2 * mu, -2 * mu], atol=1e-15)
-    u = 7.0 + np.array([0.0, ppp, 0.2, 0.8, W / 4, 1 - W / 4])
-    _, _, mus = locked_law(sc, u, np.full(u.size, 1e-5), np.zeros(u.size))
-    np.testing.assert_allclose(mus, mu * ref.friction_sign(u - 7.0, ppp, W), rtol=0, atol=1e-15)
+    wp = 107.0
+    ww = wp * 0.0681 / 0.2067
+    fr = ref.friction_moments(sc, np.array([0.0, ppp, 0.2, 0.8, W / 4]), -2.0, wp, ww)
+    expected = [0.0, 0.0, 2 * mu, -2 * mu, 2 * mu * (2 * s4 - 1)]
+    np.testing.assert_allclose(fr["T"], expected, rtol=1e-14, atol=1e-12)
+    # the locked-mode law: mu e(p) and the force with its slide mode
+    u = 7.0 + np.array([0.0, ppp, 0.2, 0.8, W / 4, 1 - W / 4, ppp + 1e-3, ppp - 3e-3])
+    n_u = u.size
+    _, _, mue, T = locked_law(
+        sc, u, np.full(n_u, 1e-5), np.zeros(n_u), w_p=np.full(n_u, wp), w_w=np.full(n_u, ww)
+    )
+    np.testing.assert_allclose(mue, mu * e(u - 7.0, W), rtol=0, atol=1e-15)
+    F = locked_law(sc, u, np.full(n_u, 1e-5), np.zeros(n_u))[0]
+    lit = ref.friction_moments(sc, u - 7.0, F, wp, ww)
+    np.testing.assert_allclose(T, lit["T"], rtol=1e-12, atol=1e-9)
+    assert 0 < abs(T[6]) < mu * F[6] and 0 < abs(T[7]) < mu * F[7]  # within v_0 of no sliding
 
 
 def test_damaged_tooth_factor_blends_at_the_tooth_change():
@@ -226,13 +242,20 @@ def test_locked_mode_law_equals_the_literal_law():
         u = rng.uniform(-1.0, 6.0, 3000)
         delta = 2e-5 + 1e-6 * rng.standard_normal(u.size)
         ddot = 1e-3 * rng.standard_normal(u.size)
-        F, E, mus = locked_law(sc, u, delta, ddot)
+        # speeds near rolling, either way round, whose sliding velocity spans |v_sl| < v_0 and beyond
+        wp = 10.0 * rng.standard_normal(u.size)
+        ww = wp * 0.0681 / 0.2067 * (1.0 + 0.02 * rng.standard_normal(u.size))
+        F, E, mue, T = locked_law(sc, u, delta, ddot, w_p=wp, w_w=ww)
         lit = ref.mesh_force_literal(sc, u, delta, ddot)
         Fr = ref.F_rated(sc)
         np.testing.assert_allclose(F, lit["F"], rtol=0, atol=1e-12 * Fr)
         np.testing.assert_allclose(E, lit["E"], rtol=0, atol=1e-18)
         mu = sc["condition"]["friction_coefficient"]
-        np.testing.assert_allclose(mus, mu * ref.friction_sign(lit["p"], 0.5, w), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(mue, mu * ref.friction_envelope(lit["p"], w), rtol=0, atol=1e-15)
+        fr = ref.friction_moments(sc, lit["p"], lit["F"], wp, ww)
+        np.testing.assert_allclose(T, fr["T"], rtol=0, atol=1e-12 * Fr)
+        slow = np.abs(fr["v_sl"]) < 0.01
+        assert 0.01 < np.mean(slow) < 0.5  # both branches of sigma are covered
         assert mesh.bA.size > 8  # ramp ends are break points
 
 
@@ -325,6 +348,7 @@ def test_two_stage_train_with_per_stage_widths_agrees_with_gearbody():
 
 
 def test_lateral_8dof_agrees_with_gearbody():
+    from gearbody_validation import reference_lateral as lat
     from gearbody_validation.reference_lateral import simulate_reference_lateral
 
     from gearbody.engine import simulate
@@ -341,7 +365,13 @@ def test_lateral_8dof_agrees_with_gearbody():
             f_ref = out["bearing_force_N"][gear][d]
             dev = np.max(np.abs(res[f"{gear}_bearing_force_{axis}_N"] - f_ref))
             assert dev < 1e-3 * np.max(np.abs(f_ref))
-    # the smoothed friction sign in the lateral outputs: T = mu |F| s(p)
+    # the friction in the lateral outputs: T = -mu e(p) |F| sigma(v_sl / v_0) of the literal law, with the
+    # centres' velocities in v_sl
     p = res["mesh_phase"]
-    T = 0.05 * np.abs(out["mesh_force_N"]) * ref.friction_sign(p, 0.5, 0.01)
+    data = scenario_to_dict(sc)
+    view = ref.stage_view(data, 0)
+    v = out["velocities"]
+    m = lat.mesh_geometry(data["design"]["stages"][0]["mesh"])["m"]
+    v_c = m @ (out["centre_velocity_m_s"]["pinion"] - out["centre_velocity_m_s"]["wheel"])
+    T = ref.friction_moments(view, p, out["mesh_force_N"], v[1], v[2], v_c)["T"]
     np.testing.assert_allclose(out["stage_friction_force_N"][0], T, rtol=0, atol=1e-6 * sc.rated_mesh_force_N)

@@ -1,8 +1,9 @@
 """The ONE segmented integrator of the reference (torsional one-mesh scenes, trains, lateral models).
 
-The mesh stiffness, the per-tooth factors, the error branch, the friction sign, the contact state
-(and in the lateral model the hertzian bearing state) change discontinuously with the state.  So the
-integration runs segment by segment in *locked modes*: between the located jumps the right-hand side
+The mesh stiffness, the per-tooth factors, the error branch, the friction arms (at the tooth change) and
+the contact state (and in the lateral model the hertzian bearing state) change discontinuously with the
+state; friction's direction has a kink.  So the integration runs segment by segment in *locked modes*:
+between the located jumps the right-hand side
 is smooth; ``solve_ivp`` stops exactly at the first mode boundary (terminal ``events``, plus a dense
 sub-step scan for boundaries crossed and re-crossed inside one step), the mode is switched and the
 integration restarts from the event state.  The time break points of the speed and load profiles are
@@ -14,20 +15,30 @@ train) and :mod:`.lateral_model`.  A system provides
 * ``n_dof``, ``meshes`` (one :class:`.mesh._Mesh` per mesh), ``speed_prof``, ``load_prof``, ``wsr``;
 * ``start_chunk(ib, t, tb)``: the profile chunk on [t, tb] (the ib-th time interval);
   ``zero_chunk()``: the chunk used when only t = 0 is output;
-* ``initial_modes(y, chunk)``: ``(modes, extra)``, ``modes[s] = [n, k, c]`` per mesh (phase period,
-  phase interval, contact mode) and ``extra`` any further mode state (lateral: bearing modes);
+* ``initial_modes(y, chunk)``: ``(modes, extra)``, ``modes[s] = [n, k, c, g]`` per mesh (phase period,
+  phase interval, contact mode, friction's slide mode) and ``extra`` any further mode state (lateral:
+  bearing modes);
 * ``make_rhs(modes, extra, chunk)``: ``(rhs, mcs)``, the right-hand side locked in the modes and the
   per-mesh mode constants;
 * ``make_events(modes, extra, mcs)``: ``(events, actions)``, terminal events leaving the modes, each
-  action ``(kind, index, value)`` with kind "phase" (mesh index, +-1), "contact" (mesh index, new c)
-  or a kind of the system's own, applied by ``switch(extra, kind, index, value, y)``;
+  action ``(kind, index, value)`` with kind "phase" (mesh index, +-1), "contact" (mesh index, new c),
+  "slide" (mesh index, new g) or a kind of the system's own, applied by ``switch(extra, kind, index,
+  value, y)``;
 * ``deflection(s, n, k, t, y)``: d = delta + E of mesh s in phase mode (n, k) and its rate;
+  ``sliding(s, mode, y)``: the sliding velocity v_sl (m/s) of mesh s in its locked mode (for
+  re-classifying the slide mode after a tooth change);
 * ``output_buffers(n_t)`` and ``outputs(ts, ys, modes, extra, mcs)``: the output arrays (time on the
   last axis, NaN-filled) and their values at the sample times ts of the current segment, evaluated
   from the dense-output states in the mode that was active when the sample time was reached.
 
-Event hysteresis: 1e-10 of a mesh period on the phase, 1e-15 m on the deflection (a state resting on
-a boundary cannot trigger an endless chain of zero-length segments; more than 1000 in a row raise).
+Friction's slide modes: the direction sigma(v_sl / v_0) of docs/scenario.md is +-1 for |v_sl| >= v_0
+and a quintic in between, with a jump of its third derivative at |v_sl| = v_0; left inside a step, that
+kink costs DOP853 its order, so each mesh with friction has a slide mode g (+1, 0, -1) and the segments
+end where |v_sl| crosses v_0 (figures: the package docstring, "Discontinuities").
+
+Event hysteresis: 1e-10 of a mesh period on the phase, 1e-15 m on the deflection, 1e-10 of v_0 on the
+sliding velocity (a state resting on a boundary cannot trigger an endless chain of zero-length
+segments; more than 1000 in a row raise).
 """
 
 from __future__ import annotations
@@ -38,10 +49,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from .modes import _slide_mode
 from .scenario import profile_value
 
 _ETA_U = 1e-10  # event hysteresis in mesh periods
 _ETA_D = 1e-15  # event hysteresis in metres of mesh deflection
+_ETA_X = 1e-10  # event hysteresis of x = v_sl / v_0 (friction's slide modes)
 _MAX_ZERO_SEGMENTS = 1000
 
 
@@ -111,6 +124,32 @@ def _contact_edges(lu: float, c: int) -> list[tuple[float, float, int]]:
     if c == -1:
         return [(lu - _ETA_D, 1.0, 0)]
     return [(-(lu + _ETA_D), 1.0, 1), (lu + _ETA_D, -1.0, -1)]
+
+
+def _slide_edges(g: int) -> list[tuple[float, float, int]]:
+    """Edges of friction's slide mode g (+1: x = v_sl / v_0 >= 1, -1: x <= -1, 0: |x| < 1) as (level of
+    x, crossing direction, slide mode after the crossing), with hysteresis _ETA_X."""
+    if g == 1:
+        return [(1.0 - _ETA_X, -1.0, 0)]
+    if g == -1:
+        return [(-1.0 + _ETA_X, 1.0, 0)]
+    return [(1.0 + _ETA_X, 1.0, 1), (-1.0 - _ETA_X, -1.0, -1)]
+
+
+def slide_events(index: int, g: int, inv_v0: float, v_sl) -> tuple[list, list]:
+    """Terminal events leaving friction's slide mode g of mesh ``index``, whose sliding velocity in
+    the current locked mode is ``v_sl(y)`` (y one state or states in columns), with their mode changes
+    ("slide", index, new g)."""
+    events, actions = [], []
+    for level, direction, new_g in _slide_edges(g):
+
+        def ev(t, y, level=level):
+            return v_sl(y) * inv_v0 - level
+
+        ev.terminal, ev.direction = True, direction
+        events.append(ev)
+        actions.append(("slide", index, new_g))
+    return events, actions
 
 
 def _segment(rhs, t: float, tb: float, y, events, method: str, rtol: float, atol, first):
@@ -263,7 +302,7 @@ def integrate(system, y: np.ndarray, t_eval: np.ndarray, rtol: float, atol, meth
                 zero_segments = zero_segments + 1 if t_new == t else 0
                 if zero_segments > _MAX_ZERO_SEGMENTS:
                     raise RuntimeError(f"mode chattering at t={t_new} (modes {modes}, {extra})")
-                phase_changed, contact_set = set(), set()
+                phase_changed, contact_set, slide_set = set(), set(), set()
                 for m in fired:
                     kind, s, val = actions[m]
                     if kind == "phase":
@@ -272,8 +311,17 @@ def integrate(system, y: np.ndarray, t_eval: np.ndarray, rtol: float, atol, meth
                     elif kind == "contact":
                         modes[s][2] = val
                         contact_set.add(s)
+                    elif kind == "slide":
+                        modes[s][3] = val
+                        slide_set.add(s)
                     else:
                         system.switch(extra, kind, s, val, y_new)
+                for s in sorted(phase_changed - slide_set):
+                    mesh = system.meshes[s]
+                    if mesh.mu != 0.0:
+                        # the friction arms jump at a tooth change, and v_sl with them: re-classify
+                        x = float(system.sliding(s, modes[s], y_new)) * mesh.inv_v0
+                        modes[s][3] = _slide_mode(x, modes[s][3])
                 for s in sorted(phase_changed - contact_set):
                     mesh = system.meshes[s]
                     if mesh.lu > 0.0:

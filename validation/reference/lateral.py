@@ -25,15 +25,18 @@ the lateral coordinates follow in the order stage 1 pinion (x, y as free), stage
 pinion, ...
 
 Per stage (geometry ``n``, ``m = s1 (-n_y, n_x)``):
-``delta = r1 phi_p - r2 phi_w + (u_p - u_w) . n``; F, T, rho_1, rho_2 as in the torsional model;
+``delta = r1 phi_p - r2 phi_w + (u_p - u_w) . n``; F, rho_1, rho_2 as in the torsional model, T with
+the centres' share in the sliding velocity (below);
 pinion: moment ``-r1 F + T rho_1``, force ``-F n + T m``; wheel: ``+r2 F - T rho_2``, ``+F n - T m``.
 Fault errors (run-out, pits) are part of the error E and enter ``d = delta + E`` only, exactly as in
 the torsional reference (its locked-mode constants and ``_mode_error``; the initial deflection uses
 ``total_error``); the lateral projection is part of ``delta`` and so sits beside them in ``d``.
 The transition width (``mesh.transition_width`` w > 0: smoothed stiffness ramps, blended factor and
-error at the tooth change, smoothed pit edges and friction sign) comes with the torsional reference's
-locked-mode law as well; only the friction sign, a constant of the mode when w = 0, is here evaluated
-from the mode's polynomial form (``_poly_eval`` / ``_mode_mu_sign``).
+error at the tooth change, smoothed pit edges and friction's envelope) comes with the torsional
+reference's locked-mode law as well.  Friction (:func:`.modes._mode_friction`): its direction opposes
+the sliding velocity ``v_sl = rho_1 phi_p' - rho_2 phi_w' + (u_p' - u_w') . m`` (the centres' velocities
+along m included, a fixed direction's velocity 0), regularised by v_0 in each mesh's slide mode as in
+the torsional reference.
 Bearing forces: linear ``-(k_x x + C_x x', k_y y + C_y y')``; hertzian
 ``-max(k_b (r - c)^n + C u'.u / r, 0) u / r`` for ``r > c``, else 0.
 

@@ -13,10 +13,10 @@ import math
 
 import numpy as np
 
-from .integrate import _chunk, _contact_edges, phase_events
+from .integrate import _chunk, _contact_edges, phase_events, slide_events
 from .lateral_scenario import _AXES, as_train, gear_names, mesh_geometry, resolve_lateral_defaults
 from .mesh import _Mesh
-from .modes import _mesh_force, _mode_error, _mode_mu_sign, _poly_eval
+from .modes import _mesh_force, _mode_error, _mode_friction, _slide_mode
 from .scenario import chain_constants, stage_F_rated, stage_view, train_stages
 
 _ETA_R = 1e-15  # event hysteresis on r - c (m)
@@ -107,15 +107,18 @@ class _LatTrain:
         op = sc["operation"]
         self.speed_prof = op["speed_profile"]
         self.load_prof = op["load_profile"]
-        # projections of the lateral coordinates on n (delta) per stage: [(index, +-n_a)]
-        self.proj = []
+        # projections of the lateral coordinates on n (delta) and on m (the centres' share of the
+        # sliding velocity, (u_p' - u_w') . m) per stage: [(index, +-n_a)], [(index, +-m_a)]
+        self.proj, self.mproj = [], []
         for s in range(N):
-            n = self.geo[s]["n"]
-            terms = []
+            n, m = self.geo[s]["n"], self.geo[s]["m"]
+            terms, mterms = [], []
             for gear, sign in zip(self.stage_gears[s], (1.0, -1.0), strict=True):
                 if gear is not None:
                     terms += [(i, sign * float(n[a])) for a, i in gear.idx.items()]
+                    mterms += [(i, sign * float(m[a])) for a, i in gear.idx.items()]
             self.proj.append(terms)
+            self.mproj.append(mterms)
 
     # -- kinematics ------------------------------------------------------------------------------
     def kin(self, s: int, y):
@@ -131,6 +134,16 @@ class _LatTrain:
     def deflection(self, s, n, k, t, y):
         u, delta, ddot = self.kin(s, y)
         return delta + _mode_error(self.meshes[s].mode_consts(n, k, 0), u - n), ddot
+
+    def sliding(self, s: int, mode: list, y):
+        """Sliding velocity v_sl = rho_1 w_p - rho_2 w_w + (u_p' - u_w') . m of stage s in its locked phase
+        mode (y one state or states in columns)."""
+        m, ip, iw, nd = self.meshes[s], self.ip[s], self.iw[s], self.n_dof
+        q = (y[ip] * m.cz - mode[0] - m.ppp) * m.pb
+        v_sl = (m.r1tan + q) * y[nd + ip] - (m.r2tan - q) * y[nd + iw]
+        for i, c in self.mproj[s]:
+            v_sl = v_sl + c * y[nd + i]
+        return v_sl
 
     # -- system interface of integrate() -------------------------------------------------------
     def start_chunk(self, ib: int, t: float, tb: float) -> dict:
@@ -172,7 +185,8 @@ class _LatTrain:
             u, _, _ = self.kin(s, y)
             n, k = m.phase_mode(float(u), float(y[self.n_dof + self.ip[s]]) * m.cz)
             d, dd = self.deflection(s, n, k, 0.0, y)
-            modes.append([n, k, m.contact_mode(float(d), float(dd))])
+            g = _slide_mode(self.sliding(s, [n, k, 0, 0], y) * m.inv_v0) if m.mu else 0
+            modes.append([n, k, m.contact_mode(float(d), float(dd)), g])
         bmodes = [g.classify(y, self.n_dof) for g in self.hertz]
         return modes, bmodes
 
@@ -181,12 +195,11 @@ class _LatTrain:
         mcs = []
         stage_data = []
         n_tor, nd = self.n_tor, self.n_dof
-        for s, (n, k, c) in enumerate(modes):
+        for s, (n, k, c, slide) in enumerate(modes):
             m = self.meshes[s]
             mc = m.mode_consts(n, k, c)
             mcs.append(mc)
-            g = self.geo[s]
-            nvec, mvec = g["n"], g["m"]
+            nvec, mvec = self.geo[s]["n"], self.geo[s]["m"]
             lat_p, lat_w = [], []
             gp, gw = self.stage_gears[s]
             if gp is not None:
@@ -202,12 +215,10 @@ class _LatTrain:
                     m.cz,
                     float(n),
                     mc,
-                    m.mu * m.iv[k][4] if mc.tw is None else mc.tw.mus,  # w > 0: mu s(p) in locked form
-                    m.ppp,
-                    m.pb,
-                    m.r1 * m.tan_a,
-                    m.r2 * m.tan_a,
+                    m,
+                    slide,
                     self.proj[s],
+                    self.mproj[s],
                     lat_p,
                     lat_w,
                 )
@@ -236,7 +247,7 @@ class _LatTrain:
         Ip = self.inertia[1:-1:2]
         Iw = self.inertia[2:-1:2]
         mesh = _mesh_force
-        peval = _poly_eval
+        friction = _mode_friction
         array = np.array
         sqrt = math.sqrt
 
@@ -252,7 +263,7 @@ class _LatTrain:
             acc = [(Ms - S[0]) / Is]
             fl = [0.0] * n_lat
             for s, sd in enumerate(stage_data):
-                ip, iw, r1, r2, cz, nf, mc, mus, ppp, pb, r1tan, r2tan, proj, lat_p, lat_w = sd
+                ip, iw, r1, r2, cz, nf, mc, m, g, proj, mproj, lat_p, lat_w = sd
                 delta = r1 * q[ip] - r2 * q[iw]
                 ddot = r1 * v[ip] - r2 * v[iw]
                 for i, c in proj:
@@ -260,10 +271,12 @@ class _LatTrain:
                     ddot += c * v[i]
                 p = q[ip] * cz - nf
                 F = mesh(mc, p, delta, ddot)
-                T = (mus if mc.tw is None else peval(mus, p)) * abs(F)
-                qq = (p - ppp) * pb
-                acc.append((S[s] - r1 * F + T * (r1tan + qq)) / Ip[s])
-                acc.append((r2 * F - T * (r2tan - qq) - S[s + 1]) / Iw[s])
+                vc = 0.0  # (u_p' - u_w') . m: the centres' share of the sliding velocity
+                for i, c in mproj:
+                    vc += c * v[i]
+                T, rho1, rho2, _ = friction(m, mc, g, p, F, v[ip], v[iw], vc)  # -mu e |F| sigma(v_sl / v_0)
+                acc.append((S[s] - r1 * F + T * rho1) / Ip[s])
+                acc.append((r2 * F - T * rho2 - S[s + 1]) / Iw[s])
                 for j, na, ma in lat_p:  # pinion: -F n + T m
                     fl[j] += -F * na + T * ma
                 for j, na, ma in lat_w:  # wheel: +F n - T m
@@ -295,7 +308,7 @@ class _LatTrain:
     # -- events ----------------------------------------------------------------------------------
     def make_events(self, modes, bmodes, mcs):
         events, actions = [], []
-        for s, (n, k, c) in enumerate(modes):
+        for s, (n, k, c, g) in enumerate(modes):
             m = self.meshes[s]
             ip = self.ip[s]
             phase, phase_actions = phase_events(s, n, k, m, ip)
@@ -311,6 +324,12 @@ class _LatTrain:
                     ev.terminal, ev.direction = True, direction
                     events.append(ev)
                     actions.append(("contact", s, new_c))
+            if m.mu:
+                ev, ac = slide_events(
+                    s, g, m.inv_v0, lambda y, s=s, mode=[n, k, c, g]: self.sliding(s, mode, y)
+                )
+                events += ev
+                actions += ac
         nd = self.n_dof
         for b, (g, bmode) in enumerate(zip(self.hertz, bmodes, strict=True)):
             edges = []
@@ -359,14 +378,15 @@ class _LatTrain:
         fmesh = {}
         for s in range(self.N):
             u, delta, ddot = self.kin(s, ys)
-            F[s] = _mesh_force(mcs[s], u - modes[s][0], delta, ddot)
-            m = self.meshes[s]
-            if mcs[s].tw is None:
-                T[s] = m.mu * m.iv[modes[s][1]][4] * np.abs(F[s])
-            else:  # transition width w > 0: smoothed friction sign
-                T[s] = _mode_mu_sign(m, modes[s][1], mcs[s], u - modes[s][0]) * np.abs(F[s])
+            p = u - modes[s][0]
+            F[s] = _mesh_force(mcs[s], p, delta, ddot)
             nvec, mvec = self.geo[s]["n"], self.geo[s]["m"]
             gp, gw = self.stage_gears[s]
+            vc = np.zeros(nt)  # (u_p' - u_w') . m
+            for i, c in self.mproj[s]:
+                vc = vc + c * ys[nd + i]
+            ip, iw, g = self.ip[s], self.iw[s], modes[s][3]
+            T[s] = _mode_friction(self.meshes[s], mcs[s], g, p, F[s], ys[nd + ip], ys[nd + iw], vc)[0]
             if gp is not None:
                 fmesh[gp.name] = -np.outer(nvec, F[s]) + np.outer(mvec, T[s])
             if gw is not None:

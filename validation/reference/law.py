@@ -1,7 +1,8 @@
 """The whole mesh law at a mesh coordinate u, literal and vectorised (used by the self-checks, the
 steady initial states and the tests; the integration uses its locked-mode form, :mod:`.modes`):
 the total error (triangle + run-out + pits, blended at the tooth change with a transition width), the
-effective stiffness and damping factor, the "pairs" sum, the mesh force and the friction moments.
+effective stiffness and damping factor, the "pairs" sum, the mesh force and the friction (its force
+from the sliding velocity, moments and power).
 """
 
 from __future__ import annotations
@@ -15,7 +16,9 @@ from .law_terms import (
     contact_weight,
     error_shape,
     error_shape_ext,
-    friction_sign,
+    friction_envelope,
+    friction_sigma,
+    friction_transition_speed,
     half_double,
     mesh_law,
     pair_table,
@@ -171,8 +174,11 @@ def mesh_force_literal(scenario: dict, u, delta, delta_dot) -> dict:
     }
 
 
-def friction_moments(scenario: dict, p, F) -> dict:
-    """T = mu |F| s and the moments M_zt1 = T rho_1, M_zt2 = T rho_2 (literal)."""
+def friction_moments(scenario: dict, p, F, w_p, w_w, v_centres=0.0) -> dict:
+    """Friction of the mesh (literal, docs/scenario.md "Friction"): arms rho_1 = r1 tan(alpha_w) + (p -
+    pitch) p_b, rho_2 = r2 tan(alpha_w) - (p - pitch) p_b, sliding velocity v_sl = rho_1 w_p - rho_2 w_w
+    + v_centres (lateral models: (u_p' - u_w') . m), T = -mu |F| e(p) sigma(v_sl / v_0), the moments
+    M_zt1 = T rho_1, M_zt2 = T rho_2 and the friction power P_f = T v_sl (<= 0)."""
     d_ = scenario["design"]
     mesh = d_["mesh"]
     r1, r2 = float(d_["pinion"]["base_radius_m"]), float(d_["wheel"]["base_radius_m"])
@@ -181,8 +187,19 @@ def friction_moments(scenario: dict, p, F) -> dict:
     tan_a = math.tan(math.radians(float(mesh["pressure_angle_deg"])))
     pb = TWO_PI * r1 / z1
     p = np.asarray(p, dtype=float)
-    s = friction_sign(p, ppp, transition_width(mesh))
-    T = float(scenario["condition"]["friction_coefficient"]) * np.abs(np.asarray(F, dtype=float)) * s
     rho1 = r1 * tan_a + (p - ppp) * pb
     rho2 = r2 * tan_a - (p - ppp) * pb
-    return {"T": T, "rho1": rho1, "rho2": rho2, "M_zt1": T * rho1, "M_zt2": T * rho2}
+    v_sl = rho1 * np.asarray(w_p, dtype=float) - rho2 * np.asarray(w_w, dtype=float) + v_centres
+    mu = float(scenario["condition"]["friction_coefficient"])
+    e = friction_envelope(p, transition_width(mesh))
+    sigma = friction_sigma(v_sl / friction_transition_speed(scenario))
+    T = -mu * np.abs(np.asarray(F, dtype=float)) * e * sigma
+    return {
+        "T": T,
+        "rho1": rho1,
+        "rho2": rho2,
+        "v_sl": v_sl,
+        "M_zt1": T * rho1,
+        "M_zt2": T * rho2,
+        "P_f": T * v_sl,
+    }

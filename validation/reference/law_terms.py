@@ -1,7 +1,8 @@
 """The terms of the mesh law of ``docs/scenario.md``, each a literal transcription of one paragraph:
 the random draw and the triangular error, run-out and pits, the smooth step of a transition width, the
 stiffness profiles ("contact-ratio" / "iso-6336-b", "table", the "pairs" table of "potential-energy"),
-the tooth factors, the friction sign and the reduced mass.  :mod:`.law` puts them together.
+the tooth factors, the friction law's regularised sign, envelope and transition speed, and the
+reduced mass.  :mod:`.law` puts them together.
 
 The ``scenario`` argument of these helpers is a mesh view (:func:`.scenario.stage_view`; a legacy
 one-mesh scenario is its own view); ``mesh`` is a stage's ``mesh`` table.
@@ -149,14 +150,32 @@ def error_shape_ext(q, a: float, e_i):
     return np.where(use_rise, rise, fall)
 
 
-def friction_sign(p, pitch_point_phase: float, w: float = 0.0):
-    """s = +1 for p < pitch, -1 otherwise (w = 0); with w > 0 and 0 < pitch < 1:
-    s = 2 [S(p/w) - S((p - pitch)/w) + S((p - 1)/w)] - 1; pitch 0 or 1: constant sign."""
+FRICTION_TRANSITION_SPEED_M_S = 0.01  # v_0 when condition.friction_transition_speed_m_s is absent
+FRICTION_TRANSITION_SPEED_RANGE_M_S = (1e-6, 1.0)
+
+
+def friction_transition_speed(scenario: dict) -> float:
+    """v_0 = condition.friction_transition_speed_m_s (absent key: 0.01 m/s), checked against 1e-6 .. 1 m/s."""
+    v0 = float(scenario["condition"].get("friction_transition_speed_m_s", FRICTION_TRANSITION_SPEED_M_S))
+    lo, hi = FRICTION_TRANSITION_SPEED_RANGE_M_S
+    if not lo <= v0 <= hi:
+        raise ValueError(f"condition.friction_transition_speed_m_s = {v0} m/s: allowed {lo} to {hi} m/s")
+    return v0
+
+
+def friction_sigma(x):
+    """Regularised sign of the friction direction, sigma(x) = 2 S(x / 2) - 1 (x = v_sl / v_0): -1 for
+    x <= -1, +1 for x >= 1, odd, sigma(0) = 0, slope 1.875 at 0."""
+    return 2.0 * smooth_step(0.5 * np.asarray(x, dtype=float)) - 1.0
+
+
+def friction_envelope(p, w: float = 0.0):
+    """Tooth-change envelope of the friction magnitude, e(p) = (2 S(p/w) - 1)(1 - 2 S((p - 1)/w)) on
+    [0, 1) (0 at the tooth change, 1 from w/2 after it to w/2 before the next); 1 for w = 0."""
     p = np.asarray(p, dtype=float)
-    ppp = float(pitch_point_phase)
-    if w > 0.0 and 0.0 < ppp < 1.0:
-        return 2.0 * (smooth_step(p / w) - smooth_step((p - ppp) / w) + smooth_step((p - 1.0) / w)) - 1.0
-    return np.where(p < ppp, 1.0, -1.0)
+    if w <= 0.0:
+        return np.ones(p.shape)
+    return (2.0 * smooth_step(p / w) - 1.0) * (1.0 - 2.0 * smooth_step((p - 1.0) / w))
 
 
 def mesh_law(mesh: dict) -> str:

@@ -12,6 +12,7 @@ import numpy as np
 from .law_terms import (
     base_stiffness,
     check_transition_width,
+    friction_transition_speed,
     half_double,
     mesh_law,
     pair_table,
@@ -26,7 +27,8 @@ from .scenario import TWO_PI, F_rated, is_muller_view
 
 
 def phase_breakpoints(scenario: dict) -> np.ndarray:
-    """All phases in [0, 1) at which some mesh quantity jumps or kinks (0 always included)."""
+    """All phases in [0, 1) at which some mesh quantity jumps or kinks (0 always included).  The pitch
+    point is none: friction's direction follows the sliding velocity, smooth in the state there."""
     mesh = scenario["design"]["mesh"]
     w = check_transition_width(scenario)
     if w > 0.0:
@@ -41,8 +43,6 @@ def phase_breakpoints(scenario: dict) -> np.ndarray:
     if law == "pairs":  # kinks of the pair tables: the grid points q_m, at p = q_m + o (mod 1)
         pts += [float(x) % 1.0 for x in pair_table(mesh)[0]]
     pts.append(float(scenario["production"]["error_mode"]["a"]))
-    if not is_muller_view(scenario) and float(scenario["condition"]["friction_coefficient"]) != 0.0:
-        pts.append(float(mesh["pitch_point_phase"]))
     for _gear, _tooth, _depth, lo, hi in pitted_teeth(scenario):  # pit edges
         pts += [lo, hi % 1.0]
     pts = np.unique([x for x in pts if 0.0 <= x < 1.0])
@@ -59,8 +59,8 @@ def _phase_breakpoints_smooth(scenario: dict, w: float) -> np.ndarray:
     """Break points with a transition width w > 0: each smoothed jump at p_c becomes a C2 ramp on
     [p_c - w/2, p_c + w/2] whose ends (where the third derivative jumps) are break points, taken
     modulo 1 (the ramps of the tooth change, 0 -+ w/2, and of anything near it straddle a period
-    end).  Kinks stay break points: p = 0 (the friction arms jump there while s passes 0), the error
-    apex a and the table points.  The centres of the ramps are not needed (the law is a polynomial
+    end).  Kinks stay break points: p = 0 (the friction arms jump there while the envelope e passes 0),
+    the error apex a and the table points.  The centres of the ramps are not needed (the law is a polynomial
     across them), so that inside every interval each smooth step is locked at 0, 1 or its polynomial.
     """
     mesh = scenario["design"]["mesh"]
@@ -74,10 +74,6 @@ def _phase_breakpoints_smooth(scenario: dict, w: float) -> np.ndarray:
         centres += [h, 1.0 - h]
     if law == "pairs":
         kinks += [float(x) % 1.0 for x in pair_table(mesh)[0]]
-    ppp = float(mesh["pitch_point_phase"])
-    if not is_muller_view(scenario) and float(scenario["condition"]["friction_coefficient"]) != 0.0:
-        if 0.0 < ppp < 1.0:
-            centres.append(ppp)
     for _gear, _tooth, _depth, lo, hi in pitted_teeth(scenario):
         centres += [lo, hi]
     pts = kinks + [(c + sgn * 0.5 * w) % 1.0 for c in centres for sgn in (-1.0, 1.0)]
@@ -108,8 +104,11 @@ class _Mesh:
         self.ppp = float(mesh["pitch_point_phase"])
         self.tan_a = math.tan(math.radians(float(mesh["pressure_angle_deg"])))
         self.pb = TWO_PI * self.r1 / self.z1
+        self.r1tan = self.r1 * self.tan_a  # the friction arms at the pitch point
+        self.r2tan = self.r2 * self.tan_a
         muller = is_muller_view(sc)
         self.mu = float(sc["condition"]["friction_coefficient"]) if not muller else 0.0
+        self.inv_v0 = 1.0 / friction_transition_speed(sc)  # 1 / v_0 of sigma(v_sl / v_0)
         self.a = float(sc["production"]["error_mode"]["a"])
         self.f, self.g = tooth_factors(sc)
         self.e_amp = tooth_error_amplitudes(sc)
@@ -134,7 +133,7 @@ class _Mesh:
         self.bA = b
         self.bB = np.append(b[1:], 1.0)
         self.K = b.size
-        self.iv = []  # per interval: (kA, kS, Ea, Eb, s)
+        self.iv = []  # per interval: (kA, kS, Ea, Eb)
         for k in range(self.K):
             lo, hi = float(self.bA[k]), float(self.bB[k])
             mid = 0.5 * (lo + hi)
@@ -147,8 +146,7 @@ class _Mesh:
                 Ea, Eb = 0.0, 1.0 / self.a
             else:
                 Ea, Eb = 1.0 / (1.0 - self.a), -1.0 / (1.0 - self.a)
-            s = 1.0 if mid < self.ppp else -1.0
-            self.iv.append((kA, kS, Ea, Eb, s))
+            self.iv.append((kA, kS, Ea, Eb))
         # scales for the default absolute tolerance
         self.m_red = reduced_mass(sc)
         kmax = max(float(np.max(base_stiffness(np.linspace(0, 1, 201), mesh))), 1.0)
@@ -172,14 +170,11 @@ class _Mesh:
         else:  # table (pairs: not used)
             kA, kS = self.iv[k][0], self.iv[k][1]
             kz = _PolyBuilder(w, mid, A=kA - kS * lo, B=kS)
-        # friction: mu s, s = 2 [S(p/w) - S((p - pitch)/w) + S((p - 1)/w)] - 1 (0 < pitch < 1)
-        if 0.0 < self.ppp < 1.0:
-            mus = _PolyBuilder(w, mid, A=-self.mu)
-            mus.step(2.0 * self.mu, 0.0)
-            mus.step(-2.0 * self.mu, self.ppp)
-            mus.step(2.0 * self.mu, 1.0)
-        else:
-            mus = _PolyBuilder(w, mid, A=self.mu * (1.0 if mid < self.ppp else -1.0))
+        # friction magnitude: mu e(p), e = (2 S(p/w) - 1)(1 - 2 S((p - 1)/w)); the two ramps do not
+        # overlap on [0, 1) (w <= 0.1), so e = 2 S(p/w) - 2 S((p - 1)/w) - 1 there
+        mue = _PolyBuilder(w, mid, A=-self.mu)
+        mue.step(2.0 * self.mu, 0.0)
+        mue.step(-2.0 * self.mu, 1.0)
         # pairs near the tooth change: (period, phase shift q - p)
         if mid < 0.5 * w:
             pairs, beta = [(n - 1, 1.0), (n, 0.0)], _PolyBuilder(w, mid)
@@ -209,7 +204,7 @@ class _Mesh:
             Es.append((E.A, E.B, tuple((cf, c - shift, iw) for cf, c, iw in E.terms)))
         return _SmoothMode(
             kz=kz.done(),
-            mus=mus.done(),
+            mue=mue.done(),
             beta=beta.done() if beta is not None else None,
             fgA=fgs[0],
             fgB=fgs[-1],
@@ -262,7 +257,7 @@ class _Mesh:
         return T[m], (T[m + 1] - T[m]) * self.inv_dq, float(self.grid[m]) - shift
 
     def mode_consts(self, n: int, k: int, c: int) -> _ModeConsts:
-        kA, kS, Ea, Eb, _s = self.iv[k]
+        kA, kS, Ea, Eb = self.iv[k]
         i, j = n % self.z1, n % self.z2
         fg = self.f[i] * self.g[j]
         pk = None

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .integrate import _ETA_U, _chunk, _contact_edges, phase_events
+from .integrate import _ETA_U, _chunk, _contact_edges, phase_events, slide_events
 from .mesh import _Mesh
-from .modes import _mesh_force, _mode_error, _poly_eval
+from .modes import _mesh_force, _mode_error, _mode_friction, _slide_mode
 from .scenario import chain_constants, stage_F_rated, stage_view, topology, train_stages
 
 
@@ -79,38 +79,46 @@ class _SingleMesh(_Mesh):
         u0, _, _ = self.kin(0.0, y, self.theta)
         n, k = self.phase_mode(u0, self.u_dot(0.0, y, chunk) if chunk else 0.0)
         d0, dd0 = self.deflection(0, n, k, 0.0, y)
-        return [[n, k, self.contact_mode(d0, dd0)]], None
+        g = _slide_mode(self.sliding(0, [n, k, 0, 0], y) * self.inv_v0) if self.mu else 0
+        return [[n, k, self.contact_mode(d0, dd0), g]], None
 
     def deflection(self, s: int, n: int, k: int, t, y) -> tuple[float, float]:
         """d = delta + E in mode (n, k) and its rate (for re-classifying the contact mode)."""
         u, delta, ddot = self.kin(t, y, self.theta)
         return delta + _mode_error(self.mode_consts(n, k, 0), u - n), ddot
 
+    def sliding(self, s: int, mode: list, y):
+        """Sliding velocity v_sl = rho_1 w_p - rho_2 w_w in the locked phase mode (two-wheel; y one state
+        or states in columns)."""
+        p = y[0] * self.cz - mode[0]
+        q = (p - self.ppp) * self.pb
+        return (self.r1tan + q) * y[2] - (self.r2tan - q) * y[3]
+
     def output_buffers(self, n_t: int) -> dict:
-        return {"F": np.full(n_t, np.nan)}
+        return {"F": np.full(n_t, np.nan), "T": np.full(n_t, np.nan)}
 
     def outputs(self, ts, ys, modes, extra, mcs) -> dict:
         u, delta, ddot = self.kin(ts, ys, self.theta)
-        return {"F": _mesh_force(mcs[0], u - modes[0][0], delta, ddot)}
+        p = u - modes[0][0]
+        F = _mesh_force(mcs[0], p, delta, ddot)
+        if self.scene == "muller":  # no friction: the pinion angle is prescribed
+            return {"F": F, "T": np.zeros(ts.size)}
+        nd = self.n_dof
+        return {"F": F, "T": _mode_friction(self, mcs[0], modes[0][3], p, F, ys[nd], ys[nd + 1])[0]}
 
     # -- right-hand sides ----------------------------------------------------------------------
     def make_rhs(self, modes: list, extra, chunk: dict):
-        ((n, k, c),) = modes
+        ((n, k, c, g),) = modes
         mc = self.mode_consts(n, k, c)
-        s = self.iv[k][4]
-        mus = self.mu * s
         ta, sa, ss, la, ls = chunk["ta"], chunk["sa"], chunk["ss"], chunk["la"], chunk["ls"]
         wsr, Mb, sb = self.wsr, self.Mb, self.sb
         sbsq = sb * sb
         Mrated = self.Mrated
         r1, r2, cz = self.r1, self.r2, self.cz
-        ppp, pb = self.ppp, self.pb
-        r1tan, r2tan = r1 * self.tan_a, r2 * self.tan_a
         mesh = _mesh_force
+        friction = _mode_friction
         nf = float(n)
         array = np.array
-        mus_poly = mc.tw.mus if mc.tw is not None else None  # w > 0: mu s(p)
-        peval = _poly_eval
 
         if self.scene == "muller":
             m = self.m_red
@@ -134,19 +142,18 @@ class _SingleMesh(_Mesh):
             tau = t - ta
             p = p1 * cz - nf
             F = mesh(mc, p, r1 * p1 - r2 * p2, r1 * w1 - r2 * w2)
-            T = (mus if mus_poly is None else peval(mus_poly, p)) * abs(F)
-            q = (p - ppp) * pb
+            T, rho1, rho2, _ = friction(self, mc, g, p, F, w1, w2)  # T = -mu e |F| sigma(v_sl / v_0)
             slip = (wsr * (sa + ss * tau) - w1) / wsr
             Ms = 2.0 * Mb * sb * slip / (slip * slip + sbsq)
             Mr = Mrated * (la + ls * tau)
-            return array([w1, w2, (Ms - r1 * F + T * (r1tan + q)) / J1, (r2 * F - T * (r2tan - q) - Mr) / J2])
+            return array([w1, w2, (Ms - r1 * F + T * rho1) / J1, (r2 * F - T * rho2 - Mr) / J2])
 
         return rhs, [mc]
 
     # -- events --------------------------------------------------------------------------------
     def make_events(self, modes: list, extra, mcs: list):
         """Terminal events leaving the locked mode; each carries the resulting mode change."""
-        ((n, k, c),) = modes
+        ((n, k, c, g),) = modes
         mc = mcs[0]
         lo = n + float(self.bA[k]) - _ETA_U
         hi = n + float(self.bB[k]) + _ETA_U
@@ -178,6 +185,10 @@ class _SingleMesh(_Mesh):
                 ev.terminal, ev.direction = True, direction
                 events.append(ev)
                 actions.append(("contact", 0, new_c))
+        if self.mu:
+            ev, ac = slide_events(0, g, self.inv_v0, lambda y, mode=list(modes[0]): self.sliding(0, mode, y))
+            events += ev
+            actions += ac
         return events, actions
 
     def default_atol(self, rtol: float) -> np.ndarray:
@@ -228,6 +239,12 @@ class _Train:
         u, delta, ddot = self.kin(s, y)
         return delta + _mode_error(self.meshes[s].mode_consts(n, k, 0), u - n), ddot
 
+    def sliding(self, s: int, mode: list, y):
+        """Sliding velocity v_sl = rho_1 w_p - rho_2 w_w of stage s in its locked phase mode."""
+        m, ip, iw, nd = self.meshes[s], self.ip[s], self.iw[s], self.n_dof
+        q = (y[ip] * m.cz - mode[0] - m.ppp) * m.pb
+        return (m.r1tan + q) * y[nd + ip] - (m.r2tan - q) * y[nd + iw]
+
     # -- system interface of integrate() -------------------------------------------------------
     def start_chunk(self, ib: int, t: float, tb: float) -> dict:
         return _chunk(self, t, tb, 0.0)
@@ -236,14 +253,19 @@ class _Train:
         return _chunk(self, 0.0, 1.0, 0.0)
 
     def output_buffers(self, n_t: int) -> dict:
-        return {"F": np.full((self.N, n_t), np.nan)}
+        return {"F": np.full((self.N, n_t), np.nan), "T": np.full((self.N, n_t), np.nan)}
 
     def outputs(self, ts, ys, modes, extra, mcs) -> dict:
         F = np.empty((self.N, ts.size))
+        T = np.empty((self.N, ts.size))
+        nd = self.n_dof
         for s in range(self.N):
             u, delta, ddot = self.kin(s, ys)
-            F[s] = _mesh_force(mcs[s], u - modes[s][0], delta, ddot)
-        return {"F": F}
+            p = u - modes[s][0]
+            F[s] = _mesh_force(mcs[s], p, delta, ddot)
+            m, g = self.meshes[s], modes[s][3]
+            T[s] = _mode_friction(m, mcs[s], g, p, F[s], ys[nd + self.ip[s]], ys[nd + self.iw[s]])[0]
+        return {"F": F, "T": T}
 
     def initial_modes(self, y, chunk):
         modes = []
@@ -251,7 +273,8 @@ class _Train:
             u, _, _ = self.kin(s, y)
             n, k = m.phase_mode(float(u), float(y[self.n_dof + self.ip[s]]) * m.cz)
             d, dd = self.deflection(s, n, k, 0.0, y)
-            modes.append([n, k, m.contact_mode(float(d), float(dd))])
+            g = _slide_mode(self.sliding(s, [n, k, 0, 0], y) * m.inv_v0) if m.mu else 0
+            modes.append([n, k, m.contact_mode(float(d), float(dd)), g])
         return modes, None
 
     # -- right-hand side in locked modes -------------------------------------------------------
@@ -260,26 +283,11 @@ class _Train:
         mode constants (for the outputs)."""
         mcs = []
         stage_data = []
-        for s, (n, k, c) in enumerate(modes):
+        for s, (n, k, c, g) in enumerate(modes):
             m = self.meshes[s]
             mc = m.mode_consts(n, k, c)
             mcs.append(mc)
-            stage_data.append(
-                (
-                    self.ip[s],
-                    self.iw[s],
-                    m.r1,
-                    m.r2,
-                    m.cz,
-                    float(n),
-                    mc,
-                    m.mu * m.iv[k][4] if mc.tw is None else mc.tw.mus,
-                    m.ppp,
-                    m.pb,
-                    m.r1 * m.tan_a,
-                    m.r2 * m.tan_a,
-                )
-            )
+            stage_data.append((self.ip[s], self.iw[s], m.r1, m.r2, m.cz, float(n), mc, m, g))
         shafts = [(2 * j, 2 * j + 1, self.shaft_k[j], self.shaft_C[j]) for j in range(self.N + 1)]
         ta, sa, ss, la, ls = chunk["ta"], chunk["sa"], chunk["ss"], chunk["la"], chunk["ls"]
         wsr, Mb, sb = self.wsr, self.Mb, self.sb
@@ -290,7 +298,7 @@ class _Train:
         Ip = self.inertia[1:-1:2]
         Iw = self.inertia[2:-1:2]
         mesh = _mesh_force
-        peval = _poly_eval
+        friction = _mode_friction
         array = np.array
 
         def rhs(t, y):
@@ -303,14 +311,13 @@ class _Train:
             Ms = 2.0 * Mb * sb * slip / (slip * slip + sbsq)
             Mr = Mrated * (la + ls * tau)
             acc = [(Ms - S[0]) / Is]  # motor: I_s phi_m'' = M_s - S_0
-            for s, (ip, iw, r1, r2, cz, nf, mc, mus, ppp, pb, r1tan, r2tan) in enumerate(stage_data):
+            for s, (ip, iw, r1, r2, cz, nf, mc, m, g) in enumerate(stage_data):
                 p = q[ip] * cz - nf
                 F = mesh(mc, p, r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw])
-                T = (mus if mc.tw is None else peval(mus, p)) * abs(F)
-                qq = (p - ppp) * pb
+                T, rho1, rho2, _ = friction(m, mc, g, p, F, v[ip], v[iw])  # T = -mu e |F| sigma(v_sl / v_0)
                 # I_ps phi_ps'' = S_{s-1} - r_ps F_s + M_zt1,s;  I_ws phi_ws'' = r_ws F_s - M_zt2,s - S_s
-                acc.append((S[s] - r1 * F + T * (r1tan + qq)) / Ip[s])
-                acc.append((r2 * F - T * (r2tan - qq) - S[s + 1]) / Iw[s])
+                acc.append((S[s] - r1 * F + T * rho1) / Ip[s])
+                acc.append((r2 * F - T * rho2 - S[s + 1]) / Iw[s])
             acc.append((S[-1] - Mr) / Im)  # machine: I_m phi_M'' = S_N - M_r
             return array(v + acc)
 
@@ -320,7 +327,7 @@ class _Train:
     def make_events(self, modes: list, extra, mcs: list):
         """Terminal events leaving the locked modes of all meshes; actions[m] = (kind, stage, value)."""
         events, actions = [], []
-        for s, (n, k, c) in enumerate(modes):
+        for s, (n, k, c, g) in enumerate(modes):
             m = self.meshes[s]
             ip, iw, cz, r1, r2 = self.ip[s], self.iw[s], m.cz, m.r1, m.r2
             phase, phase_actions = phase_events(s, n, k, m, ip)
@@ -336,6 +343,12 @@ class _Train:
                     ev.terminal, ev.direction = True, direction
                     events.append(ev)
                     actions.append(("contact", s, new_c))
+            if m.mu:
+                ev, ac = slide_events(
+                    s, g, m.inv_v0, lambda y, s=s, mode=[n, k, c, g]: self.sliding(s, mode, y)
+                )
+                events += ev
+                actions += ac
         return events, actions
 
     def default_atol(self, rtol: float) -> np.ndarray:

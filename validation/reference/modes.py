@@ -1,8 +1,9 @@
 """Locked-mode form of the mesh law: inside one phase interval k of mesh period n (and one contact
 mode c) every mesh quantity is a fixed polynomial of the phase p = u - n, stored in these constants and
 evaluated by the functions here; the right-hand sides, the contact events and the outputs all form the
-mesh force and the error through :func:`_mesh_force` / :func:`_mode_error` only.  The constants are
-built per mode by :class:`.mesh._Mesh`.
+mesh force and the error through :func:`_mesh_force` / :func:`_mode_error` only, and a parallel mesh's
+friction through :func:`_mode_friction` (its direction from the sliding velocity of the state, sigma
+locked in the mesh's slide mode g).  The constants are built per mode by :class:`.mesh._Mesh`.
 """
 
 from __future__ import annotations
@@ -71,12 +72,46 @@ def _mesh_force(mc: _ModeConsts, p, delta, delta_dot):
     return mc.fg * (mc.kA + mc.kS * (p - mc.bA)) * (d - mc.c * mc.lu) + mc.Cf * delta_dot
 
 
-def _mode_mu_sign(mesh: _Mesh, k: int, mc: _ModeConsts, p):
-    """mu s in a locked mode at p (float or array): the interval's constant with w = 0, the smoothed
-    friction sign of :func:`friction_sign` with w > 0."""
+def _mode_mu_envelope(mesh: _Mesh, mc: _ModeConsts, p):
+    """mu e(p) in a locked mode at p (float or array): mu with w = 0, mu times the tooth-change envelope
+    of :func:`.law_terms.friction_envelope` in its locked polynomial form with w > 0."""
     if mc.tw is None:
-        return mesh.mu * mesh.iv[k][4] + 0.0 * p
-    return _poly_eval(mc.tw.mus, p)
+        return mesh.mu + 0.0 * p
+    return _poly_eval(mc.tw.mue, p)
+
+
+def _slide_sigma(g: int, x):
+    """sigma(x) = 2 S(x / 2) - 1 of :func:`.law_terms.friction_sigma` (x = v_sl / v_0) locked in the
+    slide mode g: +-1 (|x| >= 1 with that sign) or, for g = 0 (|x| < 1), the quintic itself, not clipped,
+    so that it continues smoothly a little beyond |x| = 1 during trial steps (floats or arrays)."""
+    if g:
+        return g + 0.0 * x
+    u = 0.5 * x + 0.5
+    return 2.0 * (u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)) - 1.0
+
+
+def _slide_mode(x: float, g_old: int = 0) -> int:
+    """Slide mode of x = v_sl / v_0: +1 for x >= 1, -1 for x <= -1, else 0; within 1e-9 of an edge the
+    old mode is kept (the event hysteresis decides there)."""
+    x = float(x)
+    if g_old and abs(abs(x) - 1.0) < 1e-9:
+        return g_old
+    return 1 if x >= 1.0 else (-1 if x <= -1.0 else 0)
+
+
+def _mode_friction(mesh: _Mesh, mc: _ModeConsts, g: int, p, F, w1, w2, v_c=0.0):
+    """Friction of a parallel mesh in a locked mode (floats or arrays), docs/scenario.md "Friction":
+    arms rho_1 = r1 tan(alpha_w) + (p - pitch) p_b, rho_2 = r2 tan(alpha_w) - (p - pitch) p_b, sliding
+    velocity v_sl = rho_1 w1 - rho_2 w2 + v_c (v_c: the centres' (u_p' - u_w') . m of a lateral model),
+    T = -mu e(p) |F| sigma(v_sl / v_0) with sigma locked in slide mode g.  Returns (T, rho_1, rho_2,
+    v_sl); T = 0 without friction."""
+    q = (p - mesh.ppp) * mesh.pb
+    rho1 = mesh.r1tan + q
+    rho2 = mesh.r2tan - q
+    v_sl = rho1 * w1 - rho2 * w2 + v_c
+    if mesh.mu == 0.0:
+        return 0.0 * v_sl, rho1, rho2, v_sl
+    return -_mode_mu_envelope(mesh, mc, p) * abs(F) * _slide_sigma(g, v_sl * mesh.inv_v0), rho1, rho2, v_sl
 
 
 # ----------------------------------------------------------------------------------------------
@@ -88,7 +123,7 @@ def _mode_mu_sign(mesh: _Mesh, k: int, mc: _ModeConsts, p):
 # the quintic also slightly beyond the interval ends (trial steps), so the right-hand side is smooth.
 class _SmoothMode(NamedTuple):
     kz: tuple  # k_z(p) (tables: the linear piece)
-    mus: tuple  # mu s(p)
+    mue: tuple  # mu e(p), the friction's tooth-change envelope
     beta: tuple | None  # blend weight S(p/w) or S((p - 1)/w); None: a single pair (no blending)
     fgA: float  # factor of pair A (outgoing / in mesh)
     fgB: float  # factor of pair B (in mesh / incoming); X = X_A + beta (X_B - X_A)

@@ -6,11 +6,12 @@ and equations (the contract)"): a stage alone under constant torques
 The stage's model is :class:`.planetary_model.PlanetaryStage` (inertial frame, exact involute
 deflections, the reference's own mesh law per mesh).  Integration: the reference's ONE segmented
 integrator (:func:`.integrate.integrate`) with DOP853, every one of the 2N planetary meshes (and every
-parallel mesh) in its own locked mode (phase interval, contact state).  Why: the stiffness jumps at
-h and 1 - h and the tooth change would cut a plain adaptive step to first order; with terminal events
-at each mode boundary (the law angle of the mesh crossing a phase break point, or d crossing the
-backlash) each segment is smooth.  The events here are functions of the exact law angle
-(``theta_s - phi_n``, ``phi_n - theta_r + 2 pi g / z_r``), not of one coordinate.
+parallel mesh) in its own locked mode (phase interval, contact state, friction's slide mode).  Why: the
+stiffness jumps at h and 1 - h and the tooth change would cut a plain adaptive step to first order;
+with terminal events at each mode boundary (the law angle of the mesh crossing a phase break point, d
+crossing the backlash, |v_T| crossing v_0) each segment is smooth.  The events here are functions of
+the exact law angle (``theta_s - phi_n``, ``phi_n - theta_r + 2 pi g / z_r``) and of v_T on the exact
+geometry (:meth:`.planetary_model.PlanetaryStage.one_mesh_sliding`), not of one coordinate.
 Nothing is imported from gearbody.
 """
 
@@ -18,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .integrate import _ETA_U, _chunk, _contact_edges, _output_times, integrate
+from .integrate import _ETA_U, _chunk, _contact_edges, _output_times, integrate, slide_events
 from .modes import _mode_error
 from .planetary_model import PlanetaryStage
 
@@ -44,7 +45,7 @@ class _PlanetaryBlock:
         st = self.st
         geo = st.mesh_geometry(q, v)
         F = st.mesh_forces(geo, mcs, modes)
-        friction = st.friction_forces(geo, mcs, modes, F) if st.mu else None
+        friction = st.friction_forces(v, geo, mcs, modes, F) if st.mu else None
         return st.generalised_forces(q, v, geo, F, friction=friction)
 
     def initial_modes(self, q, v) -> list:
@@ -58,11 +59,15 @@ class _PlanetaryBlock:
         p = geo[4][j // 2] * law.cz - n
         return geo[0][j // 2] + _mode_error(law.mode_consts(n, k, 0), p), geo[1][j // 2]
 
+    def sliding(self, j: int, mode: list, q, v):
+        """v_T of the stage's mesh j (planet j // 2, sun mesh for even j) in its locked phase mode."""
+        return self.st.one_mesh_sliding(q, v, j // 2, ("sun", "ring")[j % 2], mode[0])
+
     def events(self, modes, mcs, nd: int):
         """Terminal events leaving the locked modes of the stage's meshes (global mesh indices)."""
         st, sl = self.st, self.sl
         events, actions = [], []
-        for j, (n, k, c) in enumerate(modes):
+        for j, (n, k, c, g) in enumerate(modes):
             planet, kind = j // 2, ("sun", "ring")[j % 2]
             law = st.planet_laws[planet][kind]
             lo, hi = n + float(law.bA[k]) - _ETA_U, n + float(law.bB[k]) + _ETA_U
@@ -87,6 +92,14 @@ class _PlanetaryBlock:
                     ev.terminal, ev.direction = True, direction
                     events.append(ev)
                     actions.append(("contact", self.m0 + j, new_c))
+            if st.mu:
+
+                def v_T(y, a=(planet, kind, n)):
+                    return st.one_mesh_sliding(y[sl], y[nd:][sl], *a)
+
+                ev, ac = slide_events(self.m0 + j, g, law.inv_v0, v_T)
+                events += ev
+                actions += ac
         return events, actions
 
     def outputs(self, qs, vs, modes, mcs) -> list:
@@ -100,7 +113,7 @@ class _PlanetaryBlock:
         """Friction forces T (N) of the stage's meshes at states in columns, in mesh order."""
         st = self.st
         F = {kind: [F_rows[2 * n + j] for n in range(st.N)] for j, kind in enumerate(("sun", "ring"))}
-        T = st.friction_forces(st.mesh_geometry(qs, vs), mcs, modes, F)[0]
+        T = st.friction_forces(vs, st.mesh_geometry(qs, vs), mcs, modes, F)[0]
         return [T[kind][n] for n in range(st.N) for kind in ("sun", "ring")]
 
 
@@ -145,8 +158,12 @@ class _Chain:
         b, j = self.block_of[s]
         return b.deflection(j, n, k, y[: self.n_dof][b.sl], y[self.n_dof :][b.sl])
 
+    def sliding(self, s: int, mode: list, y):
+        b, j = self.block_of[s]
+        return b.sliding(j, mode, y[: self.n_dof][b.sl], y[self.n_dof :][b.sl])
+
     def make_rhs(self, modes, extra, chunk):
-        mcs = [m.mode_consts(n, k, c) for m, (n, k, c) in zip(self.meshes, modes, strict=True)]
+        mcs = [m.mode_consts(n, k, c) for m, (n, k, c, _g) in zip(self.meshes, modes, strict=True)]
         nd, M, ext, blocks = self.n_dof, self.M, self.ext, self.blocks
         parts = [(b, b.sl, self._split(modes, b), self._split(mcs, b)) for b in blocks]
         ch = self.chain

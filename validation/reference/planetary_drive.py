@@ -6,8 +6,9 @@ Coordinates: ``[motor, stage 1, ..., stage N, machine]``; a parallel stage is ``
 (:mod:`.planetary_model`).  Shafts join chain angles: the motor, a pinion / wheel, ``s_in theta_in`` /
 ``s_out theta_out`` of a planetary stage; the input member receives ``s_in S_in``, the output
 ``-s_out S_out`` (the contract's turning-sense rule).  Friction ``condition.friction_coefficient`` in
-every mesh: a parallel stage's moments ``-r1 F + T rho_1``, ``r2 F - T rho_2`` (docs/scenario.md),
-the planetary meshes' forces at the contact point (docs/planetary.md, "Friction"); the steady start
+every mesh, its direction opposing the sliding velocity (``condition.friction_transition_speed_m_s``
+v_0): a parallel stage's moments ``-r1 F + T rho_1``, ``r2 F - T rho_2`` (docs/scenario.md), the
+planetary meshes' forces at the contact point (docs/planetary.md, "Friction"); the steady start
 ignores it (parallel-only trains: :func:`.simulate_reference`).
 """
 
@@ -15,18 +16,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from .integrate import _contact_edges, _output_times, integrate, phase_events
+from .integrate import _contact_edges, _output_times, integrate, phase_events, slide_events
 from .law import effective_stiffness, total_error
 from .mesh import _Mesh
-from .modes import _mesh_force, _mode_error, _mode_mu_sign
+from .modes import _mesh_force, _mode_error, _mode_friction, _slide_mode
 from .planetary import _Chain, _PlanetaryBlock, planetary_signals
 from .planetary_model import PlanetaryStage
-from .scenario import design_shafts, profile_value, steady_slip
+from .scenario import design_shafts, friction_speed, profile_value, steady_slip
 
 
 class _ParallelBlock:
-    """A parallel stage ``[pinion, wheel]`` in the chain (torsional; friction T = mu |F| s(p) with the
-    arms rho_1 = r1 tan(alpha) + (p - pitch) p_b, rho_2 = r2 tan(alpha) - (p - pitch) p_b)."""
+    """A parallel stage ``[pinion, wheel]`` in the chain (torsional; friction T = -mu e(p) |F| sigma(v_sl /
+    v_0) with the arms rho_1 = r1 tan(alpha) + (p - pitch) p_b, rho_2 = r2 tan(alpha) - (p - pitch) p_b
+    and v_sl = rho_1 w_p - rho_2 w_w, :func:`.modes._mode_friction`)."""
 
     def __init__(self, law: _Mesh, view: dict, off: int, m0: int, inertia: tuple[float, float]):
         self.law, self.view, self.off, self.m0 = law, view, off, m0
@@ -50,29 +52,34 @@ class _ParallelBlock:
         F = _mesh_force(mcs[0], p, delta, ddot)
         if not m.mu:
             return np.array([-m.r1 * F, m.r2 * F])
-        T = _mode_mu_sign(m, modes[0][1], mcs[0], p) * abs(F)
-        rho1 = m.r1 * m.tan_a + (p - m.ppp) * m.pb
-        rho2 = m.r2 * m.tan_a - (p - m.ppp) * m.pb
+        T, rho1, rho2, _ = _mode_friction(m, mcs[0], modes[0][3], p, F, v[0], v[1])
         return np.array([-m.r1 * F + T * rho1, m.r2 * F - T * rho2])
 
     def frictions(self, qs, vs, modes, mcs, F_rows) -> list:
         """Friction force T (N) at states in columns."""
         u = self._kin(qs, vs)[0]
-        return [_mode_mu_sign(self.law, modes[0][1], mcs[0], u - modes[0][0]) * np.abs(F_rows[0])]
+        return [_mode_friction(self.law, mcs[0], modes[0][3], u - modes[0][0], F_rows[0], vs[0], vs[1])[0]]
 
     def initial_modes(self, q, v) -> list:
         m = self.law
         u, delta, ddot = self._kin(q, v)
         n, k = m.phase_mode(float(u), float(v[0]) * m.cz)
         d = delta + _mode_error(m.mode_consts(n, k, 0), u - n)
-        return [[n, k, m.contact_mode(float(d), float(ddot))]]
+        g = _slide_mode(self.sliding(0, [n, k, 0, 0], q, v) * m.inv_v0) if m.mu else 0
+        return [[n, k, m.contact_mode(float(d), float(ddot)), g]]
 
     def deflection(self, j: int, n: int, k: int, q, v):
         u, delta, ddot = self._kin(q, v)
         return delta + _mode_error(self.law.mode_consts(n, k, 0), u - n), ddot
 
+    def sliding(self, j: int, mode: list, q, v):
+        """v_sl = rho_1 w_p - rho_2 w_w in the locked phase mode (q, v: the block's coordinates)."""
+        m = self.law
+        qq = (q[0] * m.cz - mode[0] - m.ppp) * m.pb
+        return (m.r1tan + qq) * v[0] - (m.r2tan - qq) * v[1]
+
     def events(self, modes, mcs, nd: int):
-        m, (n, k, c) = self.law, modes[0]
+        m, (n, k, c, g) = self.law, modes[0]
         events, actions = phase_events(self.m0, n, k, m, self.off)
         if m.lu > 0.0:
             ip, iw = self.off, self.off + 1
@@ -84,6 +91,11 @@ class _ParallelBlock:
                 ev.terminal, ev.direction = True, direction
                 events.append(ev)
                 actions.append(("contact", self.m0, new_c))
+        if m.mu:
+            sl, mode = self.sl, [n, k, c, g]
+            ev, ac = slide_events(self.m0, g, m.inv_v0, lambda y: self.sliding(0, mode, y[sl], y[nd:][sl]))
+            events += ev
+            actions += ac
         return events, actions
 
     def outputs(self, qs, vs, modes, mcs) -> list:
@@ -104,6 +116,7 @@ def _parallel_view(scenario: dict, st: dict, s: int, F_rated: float) -> dict:
         "production": {"error_mode": st["error_mode"], "eccentricity": st.get("eccentricity", [])},
         "condition": {
             "friction_coefficient": float(scenario["condition"].get("friction_coefficient", 0.0)),
+            **friction_speed(scenario),
             "damaged_teeth": st.get("damaged_teeth", []),
             "pitted_teeth": st.get("pitted_teeth", []),
         },
@@ -140,12 +153,20 @@ def build_drive(scenario: dict):
         raise ValueError(f"a drive of {len(stages)} stages needs {len(stages) + 1} shafts, got {len(shafts)}")
     seed = int(scenario["meta"]["seed"])
     mu = float(scenario["condition"].get("friction_coefficient", 0.0))
+    v0 = scenario["condition"].get("friction_transition_speed_m_s")  # None: the contract's default
     Fr = drive_F_rated(scenario)
     blocks, mass = [], [float(d["motor"]["inertia_kg_m2"])]
     off, m0 = 1, 0
     for s, st in enumerate(stages):
         if st.get("type", "parallel") == "planetary":
-            stage = PlanetaryStage(st, seed=seed, stage_index=s, F_rated=Fr[s], friction_coefficient=mu)
+            stage = PlanetaryStage(
+                st,
+                seed=seed,
+                stage_index=s,
+                F_rated=Fr[s],
+                friction_coefficient=mu,
+                friction_transition_speed_m_s=v0,
+            )
             b = _PlanetaryBlock(stage, off, m0)
         else:
             view = _parallel_view(scenario, st, s, Fr[s])

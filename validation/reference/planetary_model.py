@@ -1,7 +1,9 @@
 """A planetary stage from the contract (docs/planetary.md, "The stage in a drive: scenario keys and
 equations", and "Friction"), in the inertial frame: geometry and checks, the exact involute deflections
 and lines of action, the bearings and supports, the generalised forces (friction as a force at the
-contact point, placed from the tangent points), the rigid speeds and the static equilibrium.
+contact point, placed from the tangent points, its direction opposing v_T, the velocity whose product
+with it is the friction power: :meth:`PlanetaryStage.friction_forces`), the rigid speeds and the static
+equilibrium.
 
 Members are planar rigid bodies ``(x, y, theta)``, ordered sun, ring, carrier, planet 1 .. N (member m
 at coordinates ``3 m .. 3 m + 2``).  The mesh normal force comes from the reference's own locked-mode
@@ -17,7 +19,7 @@ import numpy as np
 
 from .lateral_scenario import bearing_force
 from .mesh import _Mesh
-from .modes import _mesh_force, _mode_error, _mode_mu_sign
+from .modes import _mesh_force, _mode_error, _mode_mu_envelope, _slide_mode, _slide_sigma
 
 MEMBERS = ("sun", "ring", "carrier")
 SUN, RING, CARRIER = 0, 1, 2
@@ -29,10 +31,23 @@ def involute(a):
 
 
 def _mesh_view(
-    z1, r1, i1, z2, r2, i2, mesh: dict, em: dict, alpha_deg: float, F_rated: float, seed: int, mu: float = 0.0
+    z1,
+    r1,
+    i1,
+    z2,
+    r2,
+    i2,
+    mesh: dict,
+    em: dict,
+    alpha_deg: float,
+    F_rated: float,
+    seed: int,
+    mu: float = 0.0,
+    v0: float | None = None,
 ):
     """A one-stage-shaped mesh view of one planetary mesh for :class:`.mesh._Mesh` (friction mu gives
-    the law's sign s(p) and its break points; no faults; the random draw is replaced by the caller)."""
+    the law's magnitude, v_0 (None: the default) its direction's transition speed; no faults; the random
+    draw is replaced by the caller)."""
     full = {
         "stiffness_profile": mesh.get("stiffness_profile", "contact-ratio"),
         "stiffness_single_N_per_m": float(mesh["stiffness_single_N_per_m"]),
@@ -46,6 +61,9 @@ def _mesh_view(
     }
     if full["stiffness_profile"] not in ("contact-ratio", "iso-6336-b"):
         raise ValueError(f"planetary mesh: stiffness_profile {full['stiffness_profile']!r} not supported")
+    condition = {"friction_coefficient": float(mu), "damaged_teeth": [], "pitted_teeth": []}
+    if v0 is not None:
+        condition["friction_transition_speed_m_s"] = float(v0)
     return {
         "meta": {"seed": seed, "scene": "train-stage", "stage_index": 0},
         "design": {
@@ -55,7 +73,7 @@ def _mesh_view(
             "machine": {"rated_torque_Nm": F_rated * r2},
         },
         "production": {"error_mode": dict(em), "eccentricity": []},
-        "condition": {"friction_coefficient": float(mu), "damaged_teeth": [], "pitted_teeth": []},
+        "condition": condition,
     }
 
 
@@ -63,7 +81,8 @@ class PlanetaryStage:
     """Constants of one planetary stage (a ``design.stages`` item with ``type = "planetary"``).
 
     ``F_rated``: the rated force per planet and mesh (scales the tolerances; kd = F / F_rated);
-    ``friction_coefficient``: mu of every sun and ring mesh (the drive's condition).
+    ``friction_coefficient``: mu of every sun and ring mesh (the drive's condition);
+    ``friction_transition_speed_m_s``: their v_0 (None: the default of the contract).
     """
 
     def __init__(
@@ -74,8 +93,10 @@ class PlanetaryStage:
         stage_index: int = 0,
         F_rated: float | None = None,
         friction_coefficient: float = 0.0,
+        friction_transition_speed_m_s: float | None = None,
     ):
         self.mu = float(friction_coefficient)
+        self.v0 = friction_transition_speed_m_s
         if stage.get("type", "planetary") != "planetary":
             raise ValueError("not a planetary stage")
         self.N = N = int(stage["planets"])
@@ -203,6 +224,7 @@ class PlanetaryStage:
                 self.F_rated,
                 seed,
                 self.mu,
+                self.v0,
             )
             view["condition"]["damaged_teeth"] = damaged(factors[kind], wheel_factors)
             law = _Mesh(view, self.F_rated)
@@ -321,19 +343,39 @@ class PlanetaryStage:
             ]
         return F
 
-    def friction_forces(self, geo, mcs, modes, F):
-        """Friction of every planet's meshes (contract "Friction"): per kind, T = mu |F| s(p) over the
-        planets, and the arm offset (p - pitch) p_b (m); p the phase in the mesh's locked mode."""
-        T, dp = {}, {}
+    def friction_forces(self, v, geo, mcs, modes, F):
+        """Friction of every planet's meshes (contract "Friction in the meshes"): per kind, over the
+        planets, T = -mu e(p) |F| sigma(v_T / v_0) with the velocity whose product with T is the friction
+        power (the generalised force of a unit T, :meth:`generalised_forces`, dotted with v),
+
+            sun mesh:  v_T = (c_n' - c_s') . m + w_s rho_s + w_p rho_p,
+            ring mesh: v_T = (c_r' - c_n') . m + w_r rho_r - w_p rho_p,
+
+        m = (n_y, -n_x), rho_1 = r_b1 tan(alpha_w) + (p - pitch) p_b, rho_p = r_bp tan(alpha_w) -+ (p -
+        pitch) p_b; and the arm offsets (p - pitch) p_b (m).  p is the phase in the mesh's locked mode; v
+        one state or states in columns.  Returns (T, offsets, v_T), each {kind: [per planet]}."""
+        T, dp, vT = {}, {}, {}
         for j, kind in enumerate(("sun", "ring")):
-            ang = geo[kind][4]
-            T[kind], dp[kind] = [], []
+            nx, ny, ang, aw = geo[kind][2], geo[kind][3], geo[kind][4], geo[kind][6]
+            ia, r1 = (0, self.r_bs) if kind == "sun" else (3, self.r_br)
+            T[kind], dp[kind], vT[kind] = [], [], []
             for n in range(self.N):
-                law, (nn, k, _) = self.planet_laws[n][kind], modes[2 * n + j]
+                law, (nn, _k, _c, g) = self.planet_laws[n][kind], modes[2 * n + j]
+                mc = mcs[2 * n + j]
                 p = ang[n] * law.cz - nn
-                T[kind].append(_mode_mu_sign(law, k, mcs[2 * n + j], p) * np.abs(F[kind][n]))
-                dp[kind].append((p - law.ppp) * law.pb)
-        return T, dp
+                off = (p - law.ppp) * law.pb
+                tan = np.tan(aw[n])
+                b = 9 + 3 * n
+                rel = (v[b] - v[ia]) * ny[n] - (v[b + 1] - v[ia + 1]) * nx[n]  # (c_n' - c_1') . m
+                if kind == "sun":
+                    v_T = rel + v[ia + 2] * (r1 * tan + off) + v[b + 2] * (self.r_bp * tan - off)
+                else:
+                    v_T = -rel + v[ia + 2] * (r1 * tan + off) - v[b + 2] * (self.r_bp * tan + off)
+                Tn = -_mode_mu_envelope(law, mc, p) * np.abs(F[kind][n]) * _slide_sigma(g, v_T * law.inv_v0)
+                T[kind].append(Tn)
+                dp[kind].append(off)
+                vT[kind].append(v_T)
+        return T, dp, vT
 
     def generalised_forces(self, q, v, geo, F, damping: bool = True, friction=None):
         """Generalised forces of meshes (-F grad delta), bearings, supports and the fixed member's
@@ -408,7 +450,7 @@ class PlanetaryStage:
         return np.stack([self.mass, self.mass, self.inertia], axis=1).ravel()
 
     def mesh_modes(self, q, v):
-        """Locked modes [n, k, c] of the 2N meshes at the state (q, v)."""
+        """Locked modes [n, k, c, g] of the 2N meshes at the state (q, v) (g: friction's slide mode)."""
         geo = self.mesh_geometry(q, v)
         modes = []
         for n in range(self.N):
@@ -418,7 +460,8 @@ class PlanetaryStage:
                 nn, k = law.phase_mode(float(ang[n] * law.cz), float(angdot[n] * law.cz))
                 mc = law.mode_consts(nn, k, 0)
                 d = float(delta[n] + _mode_error(mc, ang[n] * law.cz - nn))
-                modes.append([nn, k, law.contact_mode(d, float(ddot[n]))])
+                g = _slide_mode(self.one_mesh_sliding(q, v, n, kind, nn) * law.inv_v0) if self.mu else 0
+                modes.append([nn, k, law.contact_mode(d, float(ddot[n])), g])
         return modes
 
     def static_equilibrium(
@@ -438,7 +481,7 @@ class PlanetaryStage:
         ext[[2, 5, 8]] = torques
 
         def resid(qq, modes):
-            mcs = [law.mode_consts(nn, k, c) for law, (nn, k, c) in zip(self.meshes, modes, strict=True)]
+            mcs = [law.mode_consts(nn, k, c) for law, (nn, k, c, _g) in zip(self.meshes, modes, strict=True)]
             geo = self.mesh_geometry(qq, zero)
             Q = self.generalised_forces(qq, zero, geo, self.mesh_forces(geo, mcs, modes), damping=False)
             centrifugal = np.zeros(self.n_dof)
@@ -458,7 +501,7 @@ class PlanetaryStage:
             def locked_resid(x):
                 qq = q.copy()
                 qq[free] = x
-                return resid(qq, [[nn, k, 1] for nn, k, _ in self.mesh_modes(qq, zero)])
+                return resid(qq, [[nn, k, 1, 0] for nn, k, _c, _g in self.mesh_modes(qq, zero)])
 
             scale = np.where(free % 3 == 2, 1e-6 / self.r_c, 1e-6)
             q[free] = least_squares(
@@ -468,7 +511,7 @@ class PlanetaryStage:
         for _it in range(40):
             modes = self.mesh_modes(q, zero)
             if locked:
-                modes = [[nn, k, 1] for nn, k, _ in modes]
+                modes = [[nn, k, 1, 0] for nn, k, _c, _g in modes]
             r = resid(q, modes)
             J = np.empty((free.size, free.size))
             for c, i in enumerate(free):
@@ -501,3 +544,31 @@ class PlanetaryStage:
         R = self.r_br - self.r_bp
         delta = self.r_br * q[5] - self.r_bp * q[b + 2] - R * phi + R * involute(np.arccos(R / D))
         return phi - q[5] + 2.0 * math.pi * self.g_ring / self.z_r, delta - self.delta0["ring"][n]
+
+    def one_mesh_sliding(self, q, v, n: int, kind: str, nn: int):
+        """v_T of planet n's ``kind`` mesh in the locked phase period nn (for its slide events; q, v may
+        hold states in columns): the expressions of :meth:`friction_forces` on :meth:`one_mesh`'s
+        geometry."""
+        ia = 0 if kind == "sun" else 3
+        b = 9 + 3 * n
+        dx, dy = q[b] - q[ia], q[b + 1] - q[ia + 1]
+        D = np.hypot(dx, dy)
+        ex, ey = dx / D, dy / D
+        law = self.planet_laws[n][kind]
+        ang = self.one_mesh(q, n, kind)[0]
+        off = (ang * law.cz - nn - law.ppp) * law.pb
+        if kind == "sun":
+            R = self.r_bs + self.r_bp
+            aw = np.arccos(R / D)
+            sa, ca = np.sin(aw), np.cos(aw)
+            nx, ny = sa * ex - ca * ey, sa * ey + ca * ex
+        else:
+            R = self.r_br - self.r_bp
+            aw = np.arccos(R / D)
+            sa, ca = np.sin(aw), np.cos(aw)
+            nx, ny = -sa * ex - ca * ey, -sa * ey + ca * ex
+        tan = np.tan(aw)
+        rel = (v[b] - v[ia]) * ny - (v[b + 1] - v[ia + 1]) * nx  # (c_n' - c_1') . m, m = (n_y, -n_x)
+        if kind == "sun":
+            return rel + v[ia + 2] * (self.r_bs * tan + off) + v[b + 2] * (self.r_bp * tan - off)
+        return -rel + v[ia + 2] * (self.r_br * tan + off) - v[b + 2] * (self.r_bp * tan + off)

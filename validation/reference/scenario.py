@@ -8,7 +8,8 @@ Canonical shape (what ``gearbody.model.scenario_to_dict`` produces for every sce
 * ``design``: ``motor``, ``machine``, ``stages`` = list of ``{pinion, wheel, mesh, error_mode,
   damaged_teeth, eccentricity, pitted_teeth}``, ``shafts`` (train: N + 1 shafts, motor -> stage 1 ->
   ... -> machine; muller and two-wheel: empty, their one stage is ``stages[0]``);
-* ``condition``: ``friction_coefficient``; ``operation``, ``solver`` as before.
+* ``condition``: ``friction_coefficient`` (and ``friction_transition_speed_m_s``, default 0.01 m/s);
+  ``operation``, ``solver`` as before.
 
 The legacy shape (``meta.scene`` in {"muller", "two-wheel", "one-stage", "train"}, one-mesh scenes with
 ``design.pinion / wheel / mesh / coupling / output_shaft``, ``production.error_mode / eccentricity`` and
@@ -178,7 +179,8 @@ def stage_view(scenario: dict, s: int = 0) -> dict:
 
     Train: meta.scene becomes "train-stage" and meta.stage_index = s selects the random draw;
     production.error_mode / eccentricity and condition.damaged_teeth / pitted_teeth are the stage's own
-    (missing keys: none), condition.friction_coefficient the common one; machine.rated_torque_Nm is the
+    (missing keys: none), condition.friction_coefficient (and friction_transition_speed_m_s, when given)
+    the common ones; machine.rated_torque_Nm is the
     rated torque on this stage's wheel, F_rated,s r_ws, so that F_rated(view) = F_rated,s (to round-off).
 
     muller / two-wheel (s = 0 only): meta.scene is the topology, motor and machine are the scenario's.
@@ -207,8 +209,17 @@ def stage_view(scenario: dict, s: int = 0) -> dict:
             "friction_coefficient": friction,
             "damaged_teeth": st.get("damaged_teeth", []),
             "pitted_teeth": st.get("pitted_teeth", []),
+            **friction_speed(scenario),
         },
     }
+
+
+def friction_speed(scenario: dict) -> dict:
+    """{"friction_transition_speed_m_s": v_0} when the scenario's condition gives it, else {} (the mesh
+    helpers then take the contract's default, :func:`.law_terms.friction_transition_speed`)."""
+    key = "friction_transition_speed_m_s"
+    cond = scenario.get("condition", {})
+    return {key: float(cond[key])} if key in cond else {}
 
 
 def is_muller_view(view: dict) -> bool:

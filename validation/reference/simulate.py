@@ -22,9 +22,10 @@ def simulate_reference(
     """Integrate a resolved scenario (canonical shape, or the legacy one; see the package docstring).
 
     Returns time, coordinates and velocities (n_dof x n_t), mesh_force_N (F = F_el + F_t),
-    kd = F / F_rated, stage_mesh_force_N and stage_kd (n_stages x n_t; one row for muller and
-    two-wheel) and nfev (0-d array); for diagnostics also n_segments (restarts of solve_ivp) and
-    n_missed_events (mode boundaries found inside a step by the dense scan).
+    kd = F / F_rated, stage_mesh_force_N, stage_kd and stage_friction_force_N (the friction force T,
+    signed; n_stages x n_t; one row for muller, whose T is 0, and two-wheel) and nfev (0-d array);
+    for diagnostics also n_segments (restarts of solve_ivp) and n_missed_events (mode boundaries found
+    inside a step by the dense scan).
 
     Train (N stages): coordinates [motor, pinion_1, wheel_1, ..., pinion_N, wheel_N, machine]
     (n_dof = 2N + 2); mesh_force_N / kd are those of the first stage, stage_kd[s] = F_s / F_rated,s.
@@ -36,7 +37,7 @@ def simulate_reference(
         atol = model.default_atol(rtol)
     q0, v0 = initial_state(scenario)
     res = integrate(model, np.concatenate((q0, v0)), t_eval, rtol, atol, method)
-    nd, Y, F_out = model.n_dof, res["Y"], res["out"]["F"]
+    nd, Y, F_out, T_out = model.n_dof, res["Y"], res["out"]["F"], res["out"]["T"]
     stats = {
         "nfev": np.array(res["nfev"]),
         "n_segments": np.array(res["n_segments"]),
@@ -52,6 +53,7 @@ def simulate_reference(
             "kd": stage_kd[0].copy(),
             "stage_mesh_force_N": F_out,
             "stage_kd": stage_kd,
+            "stage_friction_force_N": T_out,
             **stats,
         }
     return {
@@ -62,5 +64,6 @@ def simulate_reference(
         "kd": F_out / model.Frated,
         "stage_mesh_force_N": F_out[None, :].copy(),
         "stage_kd": (F_out / model.Frated)[None, :],
+        "stage_friction_force_N": T_out[None, :].copy(),
         **stats,
     }
