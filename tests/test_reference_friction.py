@@ -25,7 +25,7 @@ from shapes import legacy
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SCEN = ROOT / "validation" / "scenarios"
-MU, V0 = 0.05, 0.01
+MU, V0 = 0.05, 1e-3  # V0: the default v_0
 R1, R2, Z1 = 0.0681, 0.2067, 29  # one-stage-steady.toml
 PB = 2 * math.pi * R1 / Z1
 TAN = math.tan(math.radians(20.0))
@@ -119,7 +119,7 @@ def test_direction_opposes_the_sliding_forward_backward_and_in_generator_mode():
 def test_transition_speed_default_and_range():
     sc = scenario()
     assert "friction_transition_speed_m_s" not in sc["condition"]
-    assert ref.friction_transition_speed(sc) == 0.01
+    assert ref.friction_transition_speed(sc) == V0
     sc["condition"]["friction_transition_speed_m_s"] = 0.05
     assert ref.friction_transition_speed(sc) == 0.05
     fr = ref.friction_moments(sc, 0.2, 1.0e4, 2.0, 2.0 * R1 / R2)  # v_sl = -0.0245 m/s: now inside v_0
@@ -367,16 +367,17 @@ def test_planetary_friction_power_never_positive(case, t_end):
 # ---------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("case", ["forward", "backward"])
 def test_tighter_run_agrees(case):
-    """~25 pitch points in 0.05 s of forward running (|v_sl| < v_0 for ~20 us at each), and the drive
-    turning backwards at ~-4 rad/s, where |v_sl| < v_0 over a good part of every period: the segments
+    """~25 pitch points in 0.05 s of forward running (|v_sl| < v_0 for ~2 us at each), and the drive
+    turning backwards at ~-4 rad/s, where |v_sl| < v_0 over a few % of every period: the segments
     end where |v_sl| crosses v_0 (the kink of sigma), so the default tolerance stays within 2e-5 % of
-    F_rated of rtol 1e-11 (measured 4.2e-6 % / 8.8e-6 %; without those segment ends 5.6e-5 % forward)."""
+    F_rated of rtol 1e-11 (measured with v_0 = 1e-3 m/s 4.5e-6 % / 1.5e-5 %; with 1e-2 and without those
+    segment ends 5.6e-5 % forward)."""
     sc = scenario(**{"forward": FORWARD, "backward": {**BACKWARD, "operation.t_end_s": 0.1}}[case])
     a = ref.simulate_reference(sc)
     b = ref.simulate_reference(sc, rtol=1e-11)
     Fr = ref.F_rated(sc)
     assert np.max(np.abs(a["mesh_force_N"] - b["mesh_force_N"])) < 2e-7 * Fr
-    # T follows v_sl with the slope 1.875 mu |F| / v_0 below v_0: measured 2e-7 % / 1.3e-5 % of F_rated
+    # T follows v_sl with the slope 1.875 mu |F| / v_0 below v_0: measured 2.3e-7 % / 7.4e-7 % of F_rated
     assert np.max(np.abs(a["stage_friction_force_N"] - b["stage_friction_force_N"])) < 4e-7 * Fr
     T = a["stage_friction_force_N"][0]
     if case == "forward":
@@ -386,7 +387,7 @@ def test_tighter_run_agrees(case):
         v = a["velocities"]
         v_sl = ref.friction_moments(sc, p, a["mesh_force_N"], v[1], v[2])["v_sl"]
         late = a["time"] > 0.05
-        assert v[1, late].max() < -2.0 and np.mean(np.abs(v_sl[late]) < V0) > 0.1
+        assert v[1, late].max() < -2.0 and np.mean(np.abs(v_sl[late]) < V0) > 0.01  # measured 2.3 %
 
 
 def test_train_and_drive_agree_with_friction():

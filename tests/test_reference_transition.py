@@ -125,7 +125,7 @@ def test_friction_envelope_zero_at_tooth_change_and_one_elsewhere():
     expected = [0.0, 0.0, 2 * mu, -2 * mu, 2 * mu * (2 * s4 - 1)]
     np.testing.assert_allclose(fr["T"], expected, rtol=1e-14, atol=1e-12)
     # the locked-mode law: mu e(p) and the force with its slide mode
-    u = 7.0 + np.array([0.0, ppp, 0.2, 0.8, W / 4, 1 - W / 4, ppp + 1e-3, ppp - 3e-3])
+    u = 7.0 + np.array([0.0, ppp, 0.2, 0.8, W / 4, 1 - W / 4, ppp + 2e-4, ppp - 3e-4])
     n_u = u.size
     _, _, mue, T = locked_law(
         sc, u, np.full(n_u, 1e-5), np.zeros(n_u), w_p=np.full(n_u, wp), w_w=np.full(n_u, ww)

@@ -150,12 +150,12 @@ def error_shape_ext(q, a: float, e_i):
     return np.where(use_rise, rise, fall)
 
 
-FRICTION_TRANSITION_SPEED_M_S = 0.01  # v_0 when condition.friction_transition_speed_m_s is absent
+FRICTION_TRANSITION_SPEED_M_S = 1e-3  # v_0 when condition.friction_transition_speed_m_s is absent
 FRICTION_TRANSITION_SPEED_RANGE_M_S = (1e-6, 1.0)
 
 
 def friction_transition_speed(scenario: dict) -> float:
-    """v_0 = condition.friction_transition_speed_m_s (absent key: 0.01 m/s), checked against 1e-6 .. 1 m/s."""
+    """v_0 = condition.friction_transition_speed_m_s (absent key: 1e-3 m/s, as gearbody), checked against 1e-6 .. 1 m/s."""
     v0 = float(scenario["condition"].get("friction_transition_speed_m_s", FRICTION_TRANSITION_SPEED_M_S))
     lo, hi = FRICTION_TRANSITION_SPEED_RANGE_M_S
     if not lo <= v0 <= hi:
