@@ -155,7 +155,8 @@ FRICTION_TRANSITION_SPEED_RANGE_M_S = (1e-6, 1.0)
 
 
 def friction_transition_speed(scenario: dict) -> float:
-    """v_0 = condition.friction_transition_speed_m_s (absent key: 1e-3 m/s, as gearbody), checked against 1e-6 .. 1 m/s."""
+    """v_0 = condition.friction_transition_speed_m_s (absent key: 1e-3 m/s, as gearbody), checked against
+    1e-6 .. 1 m/s."""
     v0 = float(scenario["condition"].get("friction_transition_speed_m_s", FRICTION_TRANSITION_SPEED_M_S))
     lo, hi = FRICTION_TRANSITION_SPEED_RANGE_M_S
     if not lo <= v0 <= hi:
