@@ -43,7 +43,10 @@ __all__ = [
     "write_planetary_plots",
 ]
 
-CANCELLED_CAPTION = "grey: lines McFadden & Smith's rule cancels for equally spaced identical planets"
+CANCELLED_CAPTION = (
+    'open grey markers, "(cancelled)": lines McFadden & Smith\'s rule cancels for equally spaced identical '
+    "planets; grey frequencies: peaks no line explains"
+)
 
 
 def _prefix(stage: int) -> str:

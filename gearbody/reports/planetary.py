@@ -19,7 +19,7 @@ from gearbody.analysis import (
     synchronous_average,
 )
 from gearbody.plotting.figure import png_base64
-from gearbody.plotting.planetary import CANCELLED_CAPTION, equally_spaced, ring_sensor_spectrum
+from gearbody.plotting.planetary import equally_spaced, ring_sensor_spectrum
 from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure, tsa_figure
 from gearbody.result import Result
 
@@ -43,8 +43,10 @@ def planetary_report_sections(result: Result) -> dict[str, Any]:
     if ring.window.note():
         out["window_note"] = ring.window.note()
     if equally_spaced(result, k):
-        out["cancelled_note"] = CANCELLED_CAPTION.replace(
-            "grey: lines", 'peaks marked "(cancelled)" are lines'
+        out["cancelled_note"] = (
+            'peaks labelled "(cancelled)" (open grey markers) sit at lines McFadden & Smith\'s rule cancels '
+            "for equally spaced identical planets: tooth errors, unequal sharing or the planets' own motion "
+            "bring them back"
         )
     sources = ring.sources
     peaks = ring.peaks(min_prominence_db=12.0, max_peaks=40)
