@@ -40,13 +40,26 @@ over the planets (:attr:`PlanetaryLine.survives_equal_spacing`, :mod:`gearbody.a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 from gearbody.analysis._validate import integer_at_least, is_real, positive_frequency
 from gearbody.analysis.kinematics import KinematicLine, _combination_label
 
-__all__ = ["SYMBOLS", "PlanetaryFamily", "PlanetaryLine", "PlanetarySources", "planetary_lines"]
+__all__ = [
+    "CANCELLED_MARK",
+    "SYMBOLS",
+    "PlanetaryFamily",
+    "PlanetaryLine",
+    "PlanetarySources",
+    "is_cancelled_label",
+    "mark_cancelled",
+    "planetary_lines",
+]
+
+CANCELLED_MARK = "(cancelled)"
+"""Ends the label of a line McFadden and Smith's rule cancels (:func:`mark_cancelled`)."""
 
 PlanetaryFamily = Literal["shaft", "planet_pass", "mesh", "sideband", "fault", "fault_sideband"]
 
@@ -259,3 +272,23 @@ def planetary_lines(
                     add("fault_sideband", (("f_m", k), (symbol, sign * q)))
     lines.sort(key=lambda line: line.frequency_hz)
     return lines
+
+
+def mark_cancelled(lines: Sequence[PlanetaryLine]) -> list[PlanetaryLine]:
+    """The lines, those the rule cancels for equally spaced identical planets
+    (``survives_equal_spacing`` False) relabelled "<label> (cancelled)": a peak there comes from what
+    breaks the symmetry (tooth errors, unequal load sharing, the planets' own motion), not from the
+    mesh as the rule sees it. Lines the rule lets through, or says nothing about, keep their label. Use
+    it only for equally spaced planets: otherwise the rule does not apply."""
+    out = []
+    for i, line in enumerate(lines):
+        if not isinstance(line, PlanetaryLine):
+            raise ValueError(f"lines[{i}] must be a PlanetaryLine, got {type(line).__name__}")
+        cancelled = line.survives_equal_spacing is False
+        out.append(replace(line, label=f"{line.label} {CANCELLED_MARK}") if cancelled else line)
+    return out
+
+
+def is_cancelled_label(label: str) -> bool:
+    """The label is that of a line :func:`mark_cancelled` marked as cancelled."""
+    return label.endswith(" " + CANCELLED_MARK)

@@ -107,6 +107,11 @@ def execute(args) -> int:
             v = summary[key]
             width = max(22, *(len(k) for k in keys))
             print(f"  {key:{width}s} {v:.4g}" if isinstance(v, float) else f"  {key:{width}s} {v}")
+        if result.planetary_stages:  # a ring-sensor spectrum too short for the carrier sidebands
+            from gearbody.plotting.planetary import ring_sensor_notes
+
+            for note in ring_sensor_notes(result):
+                print(f"note: {note}")
         print(
             f"wrote {out}/result.npz, scenario.toml, summary.json"
             + (f", {len(plots)} plots" if plots else "")

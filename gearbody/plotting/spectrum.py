@@ -11,6 +11,7 @@ import numpy as np
 from gearbody.analysis._validate import positive_frequency
 from gearbody.analysis.peak_report import checked_peaks
 from gearbody.analysis.peaks import LabelledPeak
+from gearbody.analysis.planetary_lines import is_cancelled_label
 from gearbody.analysis.spectrum import Spectrum
 
 from .figure import drop_overlapping, new_figure, set_title
@@ -19,6 +20,11 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 __all__ = ["plot_labelled_spectrum"]
+
+
+def _cancelled(peak: LabelledPeak) -> bool:
+    """Every label of the peak is a planetary line its phasing rule cancels."""
+    return bool(peak.labels) and all(is_cancelled_label(label) for label in peak.labels)
 
 
 def plot_labelled_spectrum(
@@ -31,7 +37,9 @@ def plot_labelled_spectrum(
     log: bool = True,
 ) -> Axes:
     """Amplitude spectrum with its peaks marked: explained peaks with their labels (rotated, small, red),
-    unexplained ones in grey with their frequency. Where labels would overlap, the explained and then
+    unexplained ones in grey with their frequency; a peak all of whose labels are planetary lines marked
+    "(cancelled)" (:func:`gearbody.analysis.planetary_lines.mark_cancelled`) in grey with an open
+    marker. Where labels would overlap, the explained and then
     the stronger peak keeps its label; every peak keeps its marker.
 
     Draws into ``ax``, or into a new Agg figure (no pyplot, global backend untouched) when None; returns
@@ -52,10 +60,19 @@ def plot_labelled_spectrum(
     ax.plot(f[keep], a[keep], linewidth=0.6, color="tab:blue")
     shown = [p for p in peaks if f_max_hz is None or p.frequency_hz <= f_max_hz]
     labels = []
-    for p in sorted(shown, key=lambda p: (not p.explained, -p.amplitude)):
-        colour = "tab:red" if p.explained else "0.5"
+    for p in sorted(shown, key=lambda p: (not p.explained, _cancelled(p), -p.amplitude)):
+        colour = ("0.45" if _cancelled(p) else "tab:red") if p.explained else "0.5"
         text = p.label if p.explained else f"{p.frequency_hz:.1f} Hz"
-        ax.plot([p.frequency_hz], [p.amplitude], marker="v", markersize=3, linestyle="none", color=colour)
+        face = "none" if _cancelled(p) else colour
+        ax.plot(
+            [p.frequency_hz],
+            [p.amplitude],
+            marker="v",
+            markersize=3,
+            linestyle="none",
+            color=colour,
+            markerfacecolor=face,
+        )
         label = ax.annotate(
             text,
             (p.frequency_hz, p.amplitude),

@@ -160,14 +160,15 @@ def write_report(result: Result, path: str | Path) -> Path:
         "text-align:right}th{background:#eee}img{max-width:100%}</style></head><body>",
         f"<h1>{title}</h1>",
         f"<p>scene <code>{html.escape(str(result.meta.get('scene', '')))}</code>, gearbody "
-        f"{html.escape(str(result.meta.get('gearbody_version', '')))}; analysed window: the last "
-        f"{result.FINAL_FRACTION:.0%} of the run; vibration signal "
-        f"<code>{html.escape(s['signal'])}</code>.</p>",
+        f"{html.escape(str(result.meta.get('gearbody_version', '')))}; analysed window: "
+        f"{html.escape(s.get('window', f'the last {result.FINAL_FRACTION:.0%} of the run'))}; vibration "
+        f"signal <code>{html.escape(s['signal'])}</code>.</p>",
         "<h2>Summary</h2>",
         _table(summary_rows),
         "<h2>K_d over the mesh period</h2>",
         img.get("kd_folded", "<p>no mesh frequency</p>"),
         "<h2>Labelled spectrum</h2>",
+        *(f"<p><b>note:</b> {html.escape(s[k])}</p>" for k in ("window_note", "cancelled_note") if s.get(k)),
         img.get("spectrum", ""),
         _table(
             s["peaks"], list(PEAK_COLUMNS), {k: v.format(unit=s["unit"]) for k, v in PEAK_COLUMNS.items()}

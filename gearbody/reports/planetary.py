@@ -1,8 +1,10 @@
 """The report's content for a run with planetary stages (:func:`gearbody.reports.html.report_sections`
 dispatches here): the first planetary stage's ring-fixed sensor as the vibration signal, its spectrum
+over whole carrier revolutions relative to the ring (:func:`gearbody.plotting.planetary.ring_sensor_window`)
 labelled with the stage's kinematic lines (carrier, planet pass, mesh harmonics and carrier sidebands,
-tooth fault frequencies), planet 1's sun-mesh K_d folded over the mesh period, and the synchronous
-average of the sensor over carrier revolutions when the window holds enough of them."""
+tooth fault frequencies; lines the phasing rule cancels marked "(cancelled)"), planet 1's sun-mesh K_d
+folded over the mesh period, and the synchronous average of the sensor over the window's carrier
+revolutions when it holds enough of them."""
 
 from __future__ import annotations
 
@@ -11,16 +13,13 @@ from typing import Any
 import numpy as np
 
 from gearbody.analysis import (
-    amplitude_spectrum,
     condition_indicators_from_average,
     fold_over_mesh_period,
-    label_peaks,
     peaks_to_rows,
     synchronous_average,
 )
-from gearbody.analysis.planetary_lines import planetary_lines
 from gearbody.plotting.figure import png_base64
-from gearbody.plotting.planetary import planetary_sources
+from gearbody.plotting.planetary import equally_spaced, ring_sensor_spectrum
 from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure, tsa_figure
 from gearbody.result import Result
 
@@ -30,28 +29,30 @@ MIN_TSA_REVOLUTIONS = 2
 
 
 def planetary_report_sections(result: Result) -> dict[str, Any]:
-    """summary, signal, unit, peaks, indicators and figures (base64 PNG) of a planetary run."""
-    win = result.final_window()
+    """summary, signal, unit, peaks, indicators, figures (base64 PNG), the analysed window ("window") and,
+    when it cannot resolve the carrier sidebands, a note ("window_note") of a planetary run."""
     k = result.planetary_stages[0]
     prefix = "" if k == 0 else f"stage_{k + 1}_"
     meta = result.meta["stages"][k]
-    name = prefix + "ring_sensor_N"
+    ring = ring_sensor_spectrum(result, k)
+    win = ring.window.mask(result.time_s.size)
+    name = ring.signal
     signal = result[name]
     out: dict[str, Any] = {"summary": result.summary(), "signal": name, "unit": "N", "figures": {}}
-    sources = planetary_sources(result, k)
-    spec = amplitude_spectrum(signal[win], result.sample_rate_hz, window="hann")
-    f_max = min(result.sample_rate_hz / 2, 3.5 * sources.mesh_hz)
-    peaks = label_peaks(
-        spec,
-        planetary_lines(sources, f_max, harmonics=3),
-        tolerance_hz=1.5 * spec.resolution_hz,
-        min_prominence_db=12.0,
-        max_peaks=40,
-        f_max_hz=f_max,
-    )
-    title = f"spectrum of {name} [N] (stage {k + 1}), last {result.FINAL_FRACTION:.0%} of the run"
+    out["window"] = f"stage {k + 1}'s ring sensor over {ring.window.describe()}"
+    if ring.window.note():
+        out["window_note"] = ring.window.note()
+    if equally_spaced(result, k):
+        out["cancelled_note"] = (
+            'peaks labelled "(cancelled)" (open grey markers) sit at lines McFadden & Smith\'s rule cancels '
+            "for equally spaced identical planets: tooth errors, unequal sharing or the planets' own motion "
+            "bring them back"
+        )
+    sources = ring.sources
+    peaks = ring.peaks(min_prominence_db=12.0, max_peaks=40)
+    title = ring.title(f"spectrum of {name} [N] (stage {k + 1})")
     out["figures"]["spectrum"] = png_base64(
-        labelled_spectrum_figure(spec, peaks, title=title, unit="N", f_max_hz=f_max)
+        labelled_spectrum_figure(ring.spectrum, peaks, title=title, unit="N", f_max_hz=ring.f_max_hz)
     )
     out["peaks"] = peaks_to_rows(peaks)
     # planet 1's sun mesh over its mesh period: the sun's angle relative to the carrier sets the phase
@@ -67,14 +68,14 @@ def planetary_report_sections(result: Result) -> dict[str, Any]:
     carrier = result[prefix + "carrier_angle_rad"][win] - result[prefix + "ring_angle_rad"][win]
     revs = abs(carrier[-1] - carrier[0]) / (2 * np.pi)
     out["indicators"] = {}
-    if revs >= MIN_TSA_REVOLUTIONS + 1 and np.all(np.diff(carrier) > 0):
+    if revs >= MIN_TSA_REVOLUTIONS + 1 - 1e-9 and np.all(np.diff(carrier) > 0):
         tsa = synchronous_average(signal[win], carrier, teeth=meta["ring_teeth"])
         out["indicators"] = condition_indicators_from_average(tsa).as_dict()
         out["tsa_revolutions"] = tsa.n_revs
         out["figures"]["tsa"] = png_base64(tsa_figure(tsa, name, "N"))
     else:
         out["tsa_note"] = (
-            f"no TSA: the final window holds {revs:.2f} carrier revolutions relative to the ring "
+            f"no TSA: the analysed window holds {revs:.2f} carrier revolutions relative to the ring "
             f"(needs {MIN_TSA_REVOLUTIONS + 1}); run longer"
         )
     return out
