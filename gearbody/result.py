@@ -208,10 +208,24 @@ class Result:
     ):
         """Labelled amplitude spectrum of ``signal`` (default: the vibration signal of the report) over the
         final ``fraction`` of the run: a :class:`LabelledSpectrum` with the spectrum and its peaks, each
-        labelled by the drive's shaft orders, mesh harmonics, sidebands and cross-modulation lines."""
+        labelled by the drive's shaft orders, mesh harmonics, sidebands and cross-modulation lines. A
+        planetary stage's ring sensor is read as in its run plot and report: order-tracked over the whole
+        carrier revolutions of the run's steady part (``fraction`` does not apply), the lines the phasing
+        rule cancels marked "(cancelled)" (docs/planetary-lines.md)."""
         from .analysis import KinematicSources, amplitude_spectrum, kinematic_lines, label_peaks
 
         name = signal or self.vibration_signal_name
+        ring = [
+            k
+            for k in self.planetary_stages
+            if name == ("" if k == 0 else f"stage_{k + 1}_") + "ring_sensor_N"
+        ]
+        if ring:  # a planetary stage's ring sensor: the spectrum of its run plot and report
+            from .plotting.planetary import ring_sensor_spectrum
+
+            rs = ring_sensor_spectrum(self, ring[0])
+            peaks = rs.peaks(min_prominence_db=min_prominence_db, max_peaks=max_peaks)
+            return LabelledSpectrum(signal=name, spectrum=rs.spectrum, peaks=peaks, f_max_hz=rs.f_max_hz)
         win = self.final_window(fraction)
         spec = amplitude_spectrum(self[name][win], self.sample_rate_hz, window="hann")
         peaks = []

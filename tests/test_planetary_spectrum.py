@@ -86,3 +86,16 @@ def test_the_report_and_the_plot_carry_the_window_and_the_marks(run, tmp_path):
     assert "analysed window: stage 1&#x27;s ring sensor over 4 carrier revolutions" in page
     assert "(cancelled)" in page
     assert "ring_sensor_spectrum.png" in {p.name for p in write_planetary_plots(run, tmp_path)}
+
+
+def test_result_spectrum_of_the_ring_sensor_is_the_run_plot_s(tmp_path):
+    """result.spectrum() of a drive whose first stage is planetary reads the ring sensor as its plot and
+    report do: over the whole carrier revolutions, the cancelled lines marked."""
+    from gearbody import load_scenario, simulate
+    from gearbody.plotting.planetary import ring_sensor_spectrum
+
+    res = simulate(load_scenario("planetary", ["operation.t_end_s=0.1", 'solver.accuracy="draft"']))
+    ls, ring = res.spectrum(), ring_sensor_spectrum(res, 0)
+    assert ls.signal == "ring_sensor_N" and ls.spectrum.resolution_hz == ring.spectrum.resolution_hz
+    assert [p.label for p in ls.peaks] == [p.label for p in ring.peaks(min_prominence_db=12.0, max_peaks=40)]
+    assert any(is_cancelled_label(label) for p in ls.peaks for label in p.label.split("; "))
