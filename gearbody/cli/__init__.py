@@ -1,4 +1,5 @@
-"""Command line: ``gearbody list | run | modes | mesh | validate | sweep | sensitivity | calibrate | render``.
+"""Command line: ``gearbody list | new | run | modes | mesh | validate | sweep | sensitivity | calibrate |
+render``.
 
 One module per command (``register(sub)`` adds its parser, ``execute(args)`` runs it; heavy imports
 happen inside ``execute``), the shared options and exit codes in :mod:`.common`. Exit codes: 0 ok,
@@ -19,7 +20,7 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from . import calibrate, listing, mesh, modes, render, run, sensitivity, sweep, validate
+from . import calibrate, listing, mesh, modes, new, render, run, sensitivity, sweep, validate
 from .common import EXIT_INTERRUPTED, EXIT_TERMINATED
 
 __all__ = ["main"]
@@ -28,6 +29,7 @@ EPILOG = """examples:
   gearbody list
   gearbody run one-stage --out runs/one-stage
   gearbody run one-stage --set production.error_mode.e_um=15 --out runs/one-stage-e15
+  gearbody new one-stage --out my-drive.toml     (a commented starting scenario for your drive)
   gearbody run my-drive.toml --t-end 1.0 --out runs/mine
   gearbody modes one-stage
   gearbody mesh one-stage-geometry --set 'condition.damaged_teeth=[{gear="pinion",tooth=0,crack_depth_mm=2}]'
@@ -36,7 +38,7 @@ EPILOG = """examples:
   gearbody render one-stage --result runs/one-stage --view front --frame gears
 """
 
-COMMANDS = (listing, run, modes, mesh, validate, sweep, sensitivity, calibrate, render)
+COMMANDS = (listing, new, run, modes, mesh, validate, sweep, sensitivity, calibrate, render)
 """In the order of ``gearbody --help``."""
 
 
