@@ -210,13 +210,12 @@ def _spectrum_axes(ax, freq, amp, log_amplitude: bool, xlim: tuple[float, float]
     if log_amplitude:
         ax.set_yscale("log")
     ax.plot(freq, amp, color="tab:blue", linewidth=0.8)
-    if amp.size and np.max(amp) > 0:
-        top = float(np.max(amp))
+    top, bottom = (float(np.max(amp)), float(np.min(amp))) if amp.size else (0.0, 0.0)
+    if top > max(bottom, 0.0):  # room above the peak: 12 % of the decades shown, or of the range
         if log_amplitude:
-            bottom = float(np.min(amp))
-            ax.set_ylim(bottom, top * (top / bottom) ** 0.12)  # 12 % of the decades above the peak
+            ax.set_ylim(bottom, top * (top / bottom) ** 0.12)
         else:
-            ax.set_ylim(min(0.0, float(np.min(amp))), top * 1.15)
+            ax.set_ylim(min(0.0, bottom), top * 1.15)
     ax.set_xlim(*xlim)
     ax.set_xlabel("Frequency f [Hz]")
     ax.set_ylabel(ylabel)
