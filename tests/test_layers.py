@@ -12,7 +12,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_import_contracts_hold():
-    exe = shutil.which("lint-imports") or str(Path(sys.executable).with_name("lint-imports"))
+    # the lint-imports of the environment running the tests (another one on PATH, say the system's,
+    # cannot import this checkout's packages: the outcome would depend on how pytest was started)
+    exe = Path(sys.executable).with_name("lint-imports")
+    exe = str(exe) if exe.exists() else (shutil.which("lint-imports") or str(exe))
     if not Path(exe).exists():
         pytest.skip("import-linter is not installed (pip install '.[test]')")
     run = subprocess.run([exe, "--config", str(ROOT / "pyproject.toml")], capture_output=True, text=True)
