@@ -52,6 +52,14 @@ def _ctrl_c_raises():
     return _sigint(signal.default_int_handler)
 
 
+@pytest.fixture
+def started_by_nohup():
+    """SIGINT ignored in this process for the test, as ``nohup pytest &`` from a script leaves it: the
+    interruption tests run in that condition every time, so none of them can come to depend on it."""
+    with _sigint(signal.SIG_IGN):
+        yield
+
+
 def _start(cmd: list[str], sigint=signal.default_int_handler, **kwargs) -> subprocess.Popen:
     """Start ``cmd`` in its own process group (a signal to the group reaches it and its workers only)
     with SIGINT handled as ``sigint`` gives it: a Python handler becomes the default action across exec
@@ -65,7 +73,7 @@ def _start(cmd: list[str], sigint=signal.default_int_handler, **kwargs) -> subpr
 # --- the engine -----------------------------------------------------------------------------------
 
 
-def test_ctrl_c_inside_the_solver_is_a_keyboard_interrupt_not_a_simulation_error():
+def test_ctrl_c_inside_the_solver_is_a_keyboard_interrupt_not_a_simulation_error(started_by_nohup):
     simulate(load_scenario(SCENE, ["operation.t_end_s=0.01"]))  # compiled and warm
     scenario = load_scenario(SCENE, ["operation.t_end_s=5.0"])  # ~5 s wall uninterrupted
     timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
@@ -188,7 +196,9 @@ def _records(out: Path) -> dict[str, tuple[str, int]]:
     return recs
 
 
-def test_an_interrupted_and_worker_killed_study_resumes_to_the_uninterrupted_results(tmp_path):
+def test_an_interrupted_and_worker_killed_study_resumes_to_the_uninterrupted_results(
+    tmp_path, started_by_nohup
+):
     out = tmp_path / "study"
     # 1. Ctrl-C during a serial study, once some cases are recorded
     proc = _sweep(out, "--workers", "1")
@@ -297,7 +307,7 @@ def test_a_case_whose_dask_workers_die_is_failed_once_with_the_cause_and_the_oth
     assert all(by_id[j]["ok"] for j in ("job-0", "job-2", "job-3")), by_id
 
 
-def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path):
+def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path, started_by_nohup):
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "gearbody.cli", "run", SCENE, "--t-end", "20", "--no-plots"]
     cmd += ["--out", str(out)]
