@@ -1,6 +1,7 @@
-"""Shared fixtures, and the ``slow`` marker: ``pytest -m "not slow"`` is the fast loop (every unit test,
-under a minute on two cores); plain ``pytest`` (CI) runs everything, the simulation-heavy comparisons with
-the independent reference included."""
+"""Shared fixtures, and the ``slow`` marker: ``pytest -m "not slow"`` is the fast loop (every unit test:
+937 tests in ~145 s on two cores, ``time pytest -m "not slow"`` on a clean clone at commit ff6e785,
+2026-12-02); plain ``pytest`` (CI) runs everything, the simulation-heavy comparisons with the independent
+reference and the docs' examples included."""
 
 from __future__ import annotations
 

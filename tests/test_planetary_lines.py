@@ -353,7 +353,7 @@ def test_surviving_lines_agree_with_the_sum_over_planets():
             assert rule.mesh_present == ((rule.harmonic * z_ring) % n == 0)
 
 
-# Parker (2000), as stated in REFERENCES.md: rotational if l Z_s / N is an integer, translational if
+# Parker (2000), as stated in docs/references.md: rotational if l Z_s / N is an integer, translational if
 # (l Z_s +- 1)/N is, planet modes otherwise. By hand:
 PARKER_CASES = [
     (21, 3, 1, "rotational"),  # 21/3 = 7

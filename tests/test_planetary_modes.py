@@ -1,5 +1,5 @@
 """Planetary stage, engine-free: geometry checks, Willis kinematics, mesh phases (Parker & Lin 2004) and the
-Lin & Parker (1999) linear model's natural modes against the paper's Table 2 (REFERENCES.md)."""
+Lin & Parker (1999) linear model's natural modes against the paper's Table 2 (docs/references.md)."""
 
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ from gearbody.physics.planetary_modal import (
     stiffness_matrix,
 )
 
-# Lin & Parker 1999, Table 2, as given in /work/shared/design/REFERENCES.md (Hz; translational: pairs)
+# Lin & Parker 1999, Table 2, as given in docs/references.md (Hz; translational: pairs)
 PUBLISHED = {
     3: {
         "rotational": [0.0, 1475.7, 1930.3, 2658.3, 7462.8, 11775.3],

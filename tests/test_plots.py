@@ -137,3 +137,50 @@ def test_labelled_spectrum_labels_do_not_overlap():
     ax = plot_labelled_spectrum(spec, peaks, title="spectrum " * 30, unit="m/s^2", f_max_hz=3000)
     texts = [text for text, _ in _assert_no_overlap_inside(ax.figure)]
     assert "2 f_z1 + 1 f_pinion" in texts  # the strongest explained peak keeps its label
+
+
+def test_shaft_markers_are_readable_and_every_marker_label_stays_inside_its_axes():
+    """The run's spectrum: shaft frequencies of 17 and 5.6 Hz on a 4 kHz axis were drawn as one line on
+    its left edge, and the highest harmonic's label at its corner (issue 25). They get a panel of their
+    own, where their lines stand well apart and off the edge, and every label sits inside its axes."""
+    from matplotlib.colors import to_rgba
+
+    from gearbody.plotting.result import spectrum_figure
+
+    fs_hz, f_mesh = 20000.0, 493.8
+    t = np.arange(10000) / fs_hz
+    x = sum(np.sin(2 * np.pi * k * f_mesh * t) / k for k in range(1, 9)) + 0.01 * np.sin(2 * np.pi * 17 * t)
+    shafts = {"f_1": f_mesh / 29, "f_2": f_mesh / 88}
+    fig = spectrum_figure(
+        amplitude_spectrum(x, fs_hz),
+        mesh_frequency_hz=f_mesh,
+        shaft_frequencies_hz=shafts,
+        title="One-stage gearbox system: spectrum of pinion_accel_rad_s2",
+        fmax_hz=8 * f_mesh,  # the 8th harmonic on the right edge
+        log_amplitude=True,
+    )
+    _assert_no_overlap_inside(fig)
+    renderer = fig.canvas.get_renderer()
+    green = to_rgba("tab:green")
+    drawn = [
+        (ax, line.get_xdata()[0])
+        for ax in fig.axes
+        for line in ax.get_lines()
+        if to_rgba(line.get_color()) == green
+    ]
+    assert sorted(f for _, f in drawn) == sorted(shafts.values())
+    ax = drawn[0][0]
+    assert all(a is ax for a, _ in drawn)  # one panel holds the shaft markers
+    frame = ax.get_window_extent(renderer)
+    xs = sorted(ax.transData.transform((f, 1.0))[0] for _, f in drawn)
+    assert xs[0] - frame.x0 >= 40 and xs[1] - xs[0] >= 40, (frame, xs)  # pixels: apart and off the edge
+    labels = {}
+    for axes in fig.axes:
+        box = axes.get_window_extent(renderer)
+        for text in axes.texts:
+            extent = text.get_window_extent(renderer)
+            inside = box.x0 - 0.5 <= extent.x0 and extent.x1 <= box.x1 + 0.5 and extent.y1 <= box.y1 + 0.5
+            assert inside, text.get_text()
+            labels[text.get_text()] = axes
+    assert labels["$8f_z$"] is labels["$f_z$"] is not ax
+    assert labels["f_1 = 17.03 Hz"] is labels["f_2 = 5.611 Hz"] is ax

@@ -1,19 +1,13 @@
-"""The README's Python example runs as written."""
+"""What the README says of itself: its quick start is CI's test command, its examples write their own
+folders, and its Fig. 9 sweep is docs/sweep.md's. That its examples run and print what it says:
+tests/test_docs.py, with every other document (the machinery: tests/doc_examples.py)."""
 
 import re
 from pathlib import Path
 
-import pytest
+from doc_examples import examples
 
 README = Path(__file__).resolve().parents[1] / "README.md"
-
-
-@pytest.mark.slow
-def test_readme_python_examples_run():
-    blocks = re.findall(r"```python\n(.*?)```", README.read_text(), re.S)
-    assert blocks
-    for code in blocks:
-        exec(compile(code, "README.md", "exec"), {})
 
 
 def test_readme_quick_start_is_the_ci_test_command():
@@ -23,25 +17,8 @@ def test_readme_quick_start_is_the_ci_test_command():
 
 
 def _readme_commands() -> list[list[str]]:
-    """Every ``gearbody ...`` command of the README's bash blocks, continuation lines joined, comments cut."""
-    import shlex
-
-    commands = []
-    for block in re.findall(r"```bash\n(.*?)```", README.read_text(), re.S):
-        for line in block.replace("\\\n", " ").splitlines():
-            words = shlex.split(line, comments=True)
-            if words[:1] == ["gearbody"]:
-                commands.append(words[1:])
-    return commands
-
-
-def test_readme_commands_parse():
-    from gearbody.cli import _parser
-
-    commands = _readme_commands()
-    assert len(commands) >= 10
-    for words in commands:
-        _parser().parse_args(words)  # SystemExit (exit 2) on an unknown option or a bad value
+    """Every ``gearbody ...`` command of the README's shell blocks, as written."""
+    return [w[1:] for b in examples(README) if b.shell for w in b.commands() if w[0] == "gearbody"]
 
 
 def test_readme_examples_write_their_own_folders():
@@ -51,7 +28,9 @@ def test_readme_examples_write_their_own_folders():
     from gearbody.cli.common import default_out
 
     writers: dict[str, set[str]] = {}  # folder -> the different commands writing it
-    for words in _readme_commands():
+    commands = _readme_commands()
+    assert len(commands) >= 10
+    for words in commands:
         args = _parser().parse_args(words)
         if args.command in ("run", "sweep", "mesh"):
             sub = {"mesh": ("mesh",)}.get(args.command, ())
@@ -72,3 +51,19 @@ def test_readme_fig9_sweep_runs_at_rated_speed_and_load_like_docs_sweep():
     docs = fig9((README.parent / "docs" / "sweep.md").read_text())
     assert docs <= readme, docs - readme
     assert any("speed_profile" in w for w in readme) and any("load_profile" in w for w in readme)
+
+
+def test_readme_says_which_scenes_have_a_run_up_case_and_which_lose_their_backlash_in_it():
+    from gearbody_validation.compare import NO_RUN_UP, cases
+
+    from gearbody.model.scenes import list_scenes
+
+    text = " ".join(README.read_text().split())
+    said = re.search(r"for every scene but (.*?) \(on bearings", text)
+    assert said and set(re.findall(r"`([\w-]+)`", said.group(1))) == set(NO_RUN_UP)
+    kept = re.search(r"It runs without backlash on every scene but `([\w-]+)`", text)
+    with_run_up = [s for s in list_scenes() if s not in NO_RUN_UP]
+    keep_backlash = [
+        s for s in with_run_up if not next(c for c in cases(s) if c.name == "run-up").no_backlash
+    ]
+    assert kept and keep_backlash == [kept.group(1)]

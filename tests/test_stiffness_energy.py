@@ -27,7 +27,7 @@ N_PHASE = 200
 
 
 def reference_pair() -> SpurPair:
-    """REFERENCES.md: 62/62, m 2 mm, 20 deg, b 20 mm, E 206 GPa, nu 0.3, bore 35 mm (radius 17.5 mm)."""
+    """docs/references.md: 62/62, m 2 mm, 20 deg, b 20 mm, E 206 GPa, nu 0.3, bore 35 mm (radius 17.5 mm)."""
     gear = SpurGear(teeth=62, module_m=0.002, face_width_m=0.02, bore_radius_m=0.0175)
     return SpurPair(gear, gear)
 

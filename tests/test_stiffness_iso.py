@@ -18,7 +18,7 @@ from gearbody.physics.stiffness_iso import (
     theoretical_single_stiffness_N_per_mm_um,
 )
 
-# ISO/TR 6336-30:2017 Example 1 (REFERENCES.md), N/(mm um)
+# ISO/TR 6336-30:2017 Example 1 (docs/references.md), N/(mm um)
 EXAMPLE_1 = {
     "c_prime_th_N_per_mm_um": 17.856,
     "c_prime_N_per_mm_um": 12.370,

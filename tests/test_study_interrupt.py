@@ -1,6 +1,13 @@
 """Studies survive interruption and failure: Ctrl-C stops a study (exit 130, finished cases kept, the
 others unrecorded), a killed pool worker fails only its own case, a resume runs every case exactly once,
-and the results are bit-identical to an uninterrupted study; studies are bounded in size."""
+and the results are bit-identical to an uninterrupted study; SIGTERM stops a command as Ctrl-C does;
+studies are bounded in size.
+
+The outcome does not depend on how pytest was started: a process started with SIGINT ignored (``nohup
+pytest &`` from a script) passes SIG_IGN on to its children, and Python then raises no
+KeyboardInterrupt. The tests set the disposition of what they interrupt: Python's own Ctrl-C handling
+(:func:`_ctrl_c_raises`) in this process, and in the commands they start (:func:`_start`), and SIGINT
+ignored where that is the point (:func:`test_sigterm_stops_a_sweep_that_ignores_ctrl_c`)."""
 
 import json
 import os
@@ -10,6 +17,7 @@ import subprocess
 import sys
 import threading
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -29,21 +37,54 @@ ROOT = Path(__file__).resolve().parents[1]
 MESSAGE = re.compile(r"^interrupted: (\d+) of 8 cases done; rerun the same command to resume$")
 
 
+@contextmanager
+def _sigint(handler):
+    """SIGINT set to ``handler`` in this process (main thread) for the block, then restored."""
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _ctrl_c_raises():
+    """Python's own Ctrl-C handling (KeyboardInterrupt), whatever this process inherited."""
+    return _sigint(signal.default_int_handler)
+
+
+@pytest.fixture
+def started_by_nohup():
+    """SIGINT ignored in this process for the test, as ``nohup pytest &`` from a script leaves it: the
+    interruption tests run in that condition every time, so none of them can come to depend on it."""
+    with _sigint(signal.SIG_IGN):
+        yield
+
+
+def _start(cmd: list[str], sigint=signal.default_int_handler, **kwargs) -> subprocess.Popen:
+    """Start ``cmd`` in its own process group (a signal to the group reaches it and its workers only)
+    with SIGINT handled as ``sigint`` gives it: a Python handler becomes the default action across exec
+    (and the child's Python then raises KeyboardInterrupt), SIG_IGN stays ignored."""
+    with _sigint(sigint):
+        return subprocess.Popen(
+            cmd, env={**os.environ, "PYTHONPATH": str(ROOT)}, start_new_session=True, **kwargs
+        )
+
+
 # --- the engine -----------------------------------------------------------------------------------
 
 
-def test_ctrl_c_inside_the_solver_is_a_keyboard_interrupt_not_a_simulation_error():
+def test_ctrl_c_inside_the_solver_is_a_keyboard_interrupt_not_a_simulation_error(started_by_nohup):
     simulate(load_scenario(SCENE, ["operation.t_end_s=0.01"]))  # compiled and warm
     scenario = load_scenario(SCENE, ["operation.t_end_s=5.0"])  # ~5 s wall uninterrupted
     timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
-    before = signal.getsignal(signal.SIGINT)  # (a unit test's watchdog may have chained its own)
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     t0 = time.perf_counter()
     timer.start()
-    with pytest.raises(KeyboardInterrupt):
+    with _ctrl_c_raises(), pytest.raises(KeyboardInterrupt):
         simulate(scenario)
     assert time.perf_counter() - t0 < 2.0  # promptly
     timer.join()
-    assert signal.getsignal(signal.SIGINT) is before  # the watchdog's hook is gone
+    assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before  # hooks gone
 
 
 # --- failure marking of the executors ---------------------------------------------------------------
@@ -110,17 +151,22 @@ def test_a_study_too_big_is_refused_before_anything_is_made(tmp_path, capsys):
 # --- the command line: interrupt, kill a worker, resume ----------------------------------------------
 
 
-def _sweep(out: Path, *extra: str) -> subprocess.Popen:
-    cmd = [sys.executable, "-m", "gearbody.cli", "sweep", SCENE, "--vary", VARY, "--t-end", T_END]
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.Popen(  # its own process group: a Ctrl-C reaches it and its workers only
-        [*cmd, *extra, "--out", str(out)],
-        env=env,
-        start_new_session=True,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+def _sweep(out: Path, *extra: str, t_end: str = T_END, sigint=signal.default_int_handler) -> subprocess.Popen:
+    cmd = [sys.executable, "-m", "gearbody.cli", "sweep", SCENE, "--vary", VARY, "--t-end", t_end]
+    return _start(
+        [*cmd, *extra, "--out", str(out)], sigint, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
+
+
+def test_a_started_command_handles_ctrl_c_even_where_this_process_ignores_it():
+    """The guard of the tests below: run under ``nohup pytest &`` they would otherwise send SIGINT to a
+    command that ignores it."""
+    probe = [sys.executable, "-c", "import signal; print(repr(signal.getsignal(signal.SIGINT)))"]
+    with _sigint(signal.SIG_IGN):
+        proc = _start(probe, stdout=subprocess.PIPE, text=True)
+    assert "default_int_handler" in proc.communicate(timeout=30)[0]
+    proc = _start(probe, signal.SIG_IGN, stdout=subprocess.PIPE, text=True)
+    assert "SIG_IGN" in proc.communicate(timeout=30)[0]
 
 
 def _wait(until, proc: subprocess.Popen, timeout_s: float = 60.0):
@@ -150,7 +196,9 @@ def _records(out: Path) -> dict[str, tuple[str, int]]:
     return recs
 
 
-def test_an_interrupted_and_worker_killed_study_resumes_to_the_uninterrupted_results(tmp_path):
+def test_an_interrupted_and_worker_killed_study_resumes_to_the_uninterrupted_results(
+    tmp_path, started_by_nohup
+):
     out = tmp_path / "study"
     # 1. Ctrl-C during a serial study, once some cases are recorded
     proc = _sweep(out, "--workers", "1")
@@ -259,17 +307,11 @@ def test_a_case_whose_dask_workers_die_is_failed_once_with_the_cause_and_the_oth
     assert all(by_id[j]["ok"] for j in ("job-0", "job-2", "job-3")), by_id
 
 
-def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path):
+def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path, started_by_nohup):
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "gearbody.cli", "run", SCENE, "--t-end", "20", "--no-plots"]
     cmd += ["--out", str(out)]
-    proc = subprocess.Popen(
-        cmd,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-        start_new_session=True,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
+    proc = _start(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     seen = b""
     while b"simulating" not in seen:  # the progress bar: the solver has run for 2 s
         chunk = proc.stderr.read1(4096)
@@ -280,3 +322,39 @@ def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path):
     assert proc.wait(timeout=30) == 130
     assert rest.strip().splitlines()[-1] == "interrupted: gearbody run stopped" and "Traceback" not in rest
     assert not (out / "result.npz").exists()
+
+
+def test_sigterm_stops_a_sweep_that_ignores_ctrl_c(tmp_path):
+    """Started as ``cmd &`` from a script starts it (SIGINT ignored, which gearbody keeps), a sweep is
+    stopped by ``kill PID``: one line, exit 143, the finished cases recorded, its pool workers gone (they
+    used to be left behind, idle, for ever)."""
+    out = tmp_path / "study"
+    proc = _sweep(out, "--workers", "2", t_end="1.0", sigint=signal.SIG_IGN)
+    running = out / ".running"
+    workers = _wait(lambda: len(_records(out)) >= 1 and running.exists() and list(running.glob("*")), proc)
+    worker_pids = {int(mark.name) for mark in workers}
+    try:
+        proc.send_signal(signal.SIGTERM)  # the parent only, as kill PID does
+        _, err = proc.communicate(timeout=30)  # (left-behind workers would hold its pipes open)
+        assert proc.returncode == 143, err
+        assert "Traceback" not in err
+        done = int(MESSAGE.match(err.strip().splitlines()[-1]).group(1))
+        assert 1 <= done < 8 and len(_records(out)) == done
+        t0 = time.monotonic()
+        while any(map(_running, worker_pids)) and time.monotonic() - t0 < 10:
+            time.sleep(0.05)
+        assert not any(map(_running, worker_pids))
+    finally:
+        try:  # whatever failed, leave nothing of it running
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+
+def _running(pid: int) -> bool:
+    """The process exists and is not a zombie (Linux /proc)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except (FileNotFoundError, ProcessLookupError):
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] != "Z"

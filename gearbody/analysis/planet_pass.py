@@ -16,7 +16,7 @@ coefficients W_0 = 1/2 and W_+-1 = 1/4 give spectra one can work out by hand. In
 write the modulation as a general periodic function of the carrier angle; any callable window can be
 passed to :func:`ring_sensor_signal`, and the rule below holds for every 2 pi periodic window.
 
-The rule (McFadden & Smith 1985; REFERENCES.md "Ring-fixed sensor"): planet n at psi_n = theta_c + 2 pi n/N
+The rule (McFadden & Smith 1985; docs/references.md): planet n at psi_n = theta_c + 2 pi n/N
 meshes with a ring tooth Z_r psi_n / 2 pi mesh periods after planet 0. With the window's Fourier series
 w(phi) = sum_q W_q e^(i q phi) and the mesh force F(Z_r psi) = sum_k F_k e^(i k Z_r psi), the sum over
 planets keeps only e^(i (k Z_r + q) theta_c) with (k Z_r + q) = 0 mod N: lines at (k Z_r + q) f_c.
@@ -189,7 +189,7 @@ def surviving_lines(
     |q| <= q_range and (k Z_r + q) = 0 mod N. The mesh harmonic is present iff k Z_r / N is an integer
     (then the sidebands sit at +-N f_c, +-2N f_c, ...); otherwise it is suppressed and the nearest
     surviving q, -(k Z_r mod N) or N - (k Z_r mod N), makes the sidebands asymmetric
-    (McFadden & Smith 1985; REFERENCES.md).
+    (McFadden & Smith 1985; docs/references.md).
     """
     z_ring = integer_at_least("z_ring", z_ring, 3)
     n = integer_at_least("n_planets", n_planets, 1)
@@ -223,7 +223,7 @@ Excitation = Literal["rotational", "translational", "planet"]
 def phasing_excitation(z_sun: int, n_planets: int, harmonic: int) -> Excitation:
     """The modes the l-th mesh harmonic excites, by Parker's planet-phasing rule.
 
-    With N equally spaced planets (Parker 2000, J. Sound Vib. 236:561-573; REFERENCES.md): mesh harmonic
+    With N equally spaced planets (Parker 2000, J. Sound Vib. 236:561-573; docs/references.md): mesh harmonic
     l excites only rotational modes if l Z_s / N is an integer, only translational modes if
     (l Z_s + 1) / N or (l Z_s - 1) / N is an integer, and only planet modes otherwise. (The ring meshes
     give the same answer: equal spacing needs (Z_s + Z_r)/N integer, so Z_r = -Z_s mod N.) The rule needs

@@ -30,7 +30,7 @@ Signal Process. 34:165-178.
 
 Sources: McFadden & Smith (1985), Proc. IMechE 199(C1):65-70 (ring-fixed sensor, planet pass, carrier
 sidebands); Inalpolat & Kahraman (2009), J. Sound Vib. 323:677-696 (sidebands of a fixed sensor, the
-sun, planet and ring fault modulations); Feng & Zuo (2012); /work/shared/design/REFERENCES.md,
+sun, planet and ring fault modulations); Feng & Zuo (2012); docs/references.md,
 "Planetary stages". The citations of the fault frequencies are from memory; the formulas themselves
 follow from the tooth counting above and are checked by the Willis identities in the tests. For
 equally spaced, identical planets McFadden and Smith's rule says which of these lines survive the sum

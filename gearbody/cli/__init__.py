@@ -1,18 +1,27 @@
-"""Command line: ``gearbody list | run | modes | mesh | validate | sweep | sensitivity | calibrate | render``.
+"""Command line: ``gearbody list | new | run | modes | mesh | validate | sweep | sensitivity | calibrate |
+render``.
 
 One module per command (``register(sub)`` adds its parser, ``execute(args)`` runs it; heavy imports
 happen inside ``execute``), the shared options and exit codes in :mod:`.common`. Exit codes: 0 ok,
 1 something failed (validation, sweep cases), 2 bad input (invalid scenario or option), 3 simulation
-failed, 130 interrupted (Ctrl-C: one line, no traceback).
+failed, 130 interrupted (Ctrl-C: one line, no traceback), 143 stopped by SIGTERM (the same clean stop).
+
+Signals: an inherited SIGINT disposition is kept (a job started with ``cmd &`` from a script ignores
+Ctrl-C on purpose, and so does gearbody); SIGTERM, the way to stop such a job (``kill PID``), stops a
+command as Ctrl-C does: finished cases and evaluations stay recorded and pool workers are stopped.
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 
-from . import calibrate, listing, mesh, modes, render, run, sensitivity, sweep, validate
-from .common import EXIT_INTERRUPTED
+from . import calibrate, listing, mesh, modes, new, render, run, sensitivity, sweep, validate
+from .common import EXIT_INTERRUPTED, EXIT_TERMINATED
 
 __all__ = ["main"]
 
@@ -20,6 +29,7 @@ EPILOG = """examples:
   gearbody list
   gearbody run one-stage --out runs/one-stage
   gearbody run one-stage --set production.error_mode.e_um=15 --out runs/one-stage-e15
+  gearbody new one-stage --out my-drive.toml     (a commented starting scenario for your drive)
   gearbody run my-drive.toml --t-end 1.0 --out runs/mine
   gearbody modes one-stage
   gearbody mesh one-stage-geometry --set 'condition.damaged_teeth=[{gear="pinion",tooth=0,crack_depth_mm=2}]'
@@ -28,7 +38,7 @@ EPILOG = """examples:
   gearbody render one-stage --result runs/one-stage --view front --frame gears
 """
 
-COMMANDS = (listing, run, modes, mesh, validate, sweep, sensitivity, calibrate, render)
+COMMANDS = (listing, new, run, modes, mesh, validate, sweep, sensitivity, calibrate, render)
 """In the order of ``gearbody --help``."""
 
 
@@ -45,27 +55,53 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+@contextmanager
+def _sigterm_stops() -> Iterator[list[int]]:
+    """While the command runs, SIGTERM raises KeyboardInterrupt (the list yielded gets the signal), so
+    ``kill PID`` stops it as Ctrl-C does; a SIGTERM disposition set by the caller (ignored, a handler) is
+    kept, and the previous one comes back afterwards."""
+    received: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+    previous = signal.getsignal(signal.SIGTERM)
+    if previous is not signal.SIG_DFL:
+        yield received
+        return
+
+    def stop(signum, frame):
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, stop)
+    try:
+        yield received
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: list[str] | None = None) -> int:
     from gearbody.errors import GearbodyError, ScenarioError, SimulationError
 
     from .common import check_options
 
     args = _parser().parse_args(argv)
-    try:
-        check_options(args)
-        return args.handler(args)
-    except GearbodyError as exc:  # recognised by type: each error class carries its exit code
-        kind = (
-            "invalid scenario"
-            if isinstance(exc, ScenarioError)
-            else "simulation failed"
-            if isinstance(exc, SimulationError)
-            else "invalid input"
-            if exc.exit_code == 2
-            else "failed"
-        )
-        print(f"gearbody: {kind}: {exc}", file=sys.stderr)
-        return exc.exit_code
-    except KeyboardInterrupt as exc:  # a study says how far it got (StudyInterrupted)
-        print(str(exc) or f"interrupted: gearbody {args.command} stopped", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    with _sigterm_stops() as terminated:
+        try:
+            check_options(args)
+            return args.handler(args)
+        except GearbodyError as exc:  # recognised by type: each error class carries its exit code
+            kind = (
+                "invalid scenario"
+                if isinstance(exc, ScenarioError)
+                else "simulation failed"
+                if isinstance(exc, SimulationError)
+                else "invalid input"
+                if exc.exit_code == 2
+                else "failed"
+            )
+            print(f"gearbody: {kind}: {exc}", file=sys.stderr)
+            return exc.exit_code
+        except KeyboardInterrupt as exc:  # a study says how far it got (StudyInterrupted)
+            print(str(exc) or f"interrupted: gearbody {args.command} stopped", file=sys.stderr)
+            return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED

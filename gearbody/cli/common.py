@@ -19,6 +19,7 @@ __all__ = [
     "OutOfRange",
     "EXIT_OK",
     "EXIT_SIMULATION",
+    "EXIT_TERMINATED",
     "EXIT_USAGE",
     "add_executor",
     "add_out",
@@ -42,6 +43,8 @@ EXIT_SIMULATION = 3
 """The simulation failed (SimulationError)."""
 EXIT_INTERRUPTED = 130
 """Stopped by Ctrl-C (SIGINT), as a shell reports a process killed by SIGINT (128 + 2)."""
+EXIT_TERMINATED = 143
+"""Stopped by SIGTERM (``kill PID``), with the same clean stop as Ctrl-C (128 + 15)."""
 
 
 def add_set(parser: argparse.ArgumentParser, help: str) -> None:

@@ -102,9 +102,10 @@ class StallWatchdog:
     step control can reject steps at the minimum step size forever) and the memory limit (growth of the
     process's resident memory while solving). Hot force functions use :meth:`ticker`.
 
-    While it watches (from :meth:`watch` to :meth:`close`) it also notes a Ctrl-C (SIGINT) in
-    ``interrupted``: Exudyn turns a KeyboardInterrupt raised inside a user function into its own
-    error, and the caller re-raises KeyboardInterrupt from this flag."""
+    While it watches (from :meth:`watch` to :meth:`close`) it also notes a Ctrl-C (SIGINT), or a SIGTERM
+    that the command line turns into the same stop, in ``interrupted``: Exudyn turns a KeyboardInterrupt
+    raised inside a user function into its own error, and the caller re-raises KeyboardInterrupt from
+    this flag."""
 
     def __init__(self) -> None:
         self.calls, self.t_check, self.t_max = 0, -1.0, -1.0
@@ -125,7 +126,7 @@ class StallWatchdog:
             "check stiffness, inertia and load values, or tighten solver tolerances / lower solver.max_step_s"
         )
         self.interrupted = False
-        self._sigint_handler = None
+        self._chained: dict[int, object] = {}  # signal -> the handler it replaced while watching
 
     def watch(
         self,
@@ -158,20 +159,22 @@ class StallWatchdog:
         self._note_interrupts()
 
     def _note_interrupts(self) -> None:
-        """Chain a SIGINT handler that sets ``interrupted`` before the previous handler runs (only in the
-        main thread, and only where SIGINT is handled by Python: not where it is ignored)."""
-        if threading.current_thread() is not threading.main_thread() or self._sigint_handler is not None:
+        """Chain a SIGINT (and SIGTERM) handler that sets ``interrupted`` before the previous handler
+        runs (only in the main thread, and only where the signal is handled by Python: not where it is
+        ignored or left to its default action)."""
+        if threading.current_thread() is not threading.main_thread() or self._chained:
             return
-        previous = signal.getsignal(signal.SIGINT)
-        if not callable(previous):  # SIG_IGN (a pool worker) or SIG_DFL: nothing raises in Python
-            return
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            previous = signal.getsignal(signum)
+            if not callable(previous):  # SIG_IGN (a pool worker, `cmd &`) or SIG_DFL: nothing raises
+                continue
 
-        def note(signum, frame):
-            self.interrupted = True
-            previous(signum, frame)
+            def note(signum, frame, previous=previous):
+                self.interrupted = True
+                previous(signum, frame)
 
-        self._sigint_handler = previous
-        signal.signal(signal.SIGINT, note)
+            self._chained[signum] = previous
+            signal.signal(signum, note)
 
     def __call__(self, t: float, speed: float) -> None:
         self.calls += 1
@@ -260,9 +263,9 @@ class StallWatchdog:
         return self.failure
 
     def close(self) -> None:
-        if self._sigint_handler is not None:
-            signal.signal(signal.SIGINT, self._sigint_handler)
-            self._sigint_handler = None
+        for signum, previous in self._chained.items():
+            signal.signal(signum, previous)
+        self._chained = {}
         if self.bar is not None:
             self.bar.n = self.bar.total
             self.bar.close()

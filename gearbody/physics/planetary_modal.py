@@ -121,7 +121,7 @@ class PlanetaryModalParameters:
 def lin_parker_1999_parameters(
     n_planets: int, planet_angles_rad: tuple[float, ...] | None = None
 ) -> PlanetaryModalParameters:
-    """The example of Lin & Parker 1999, Table 1 (docs/planetary.md; REFERENCES.md): masses
+    """The example of Lin & Parker 1999, Table 1 (docs/planetary.md; docs/references.md): masses
     carrier/ring/sun/planet 5.43/2.35/0.4/0.66 kg, I/r^2 6.29/3.00/0.39/0.61 kg, meshes 5e8 N/m, all
     bearings 1e8 N/m, ring torsion 1e9 N/m (sun and carrier free), pressure angles 24.6 deg; planets
     equally spaced unless angles are given."""

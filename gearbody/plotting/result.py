@@ -129,6 +129,10 @@ def plot_kd_folded(
     return save_figure(fig, path, dpi)
 
 
+SHAFT_PANEL_ORDERS = 4.5
+"""The low-frequency panel of a spectrum spans 0 .. this many times the fastest shaft frequency."""
+
+
 def spectrum_figure(
     spectrum: Spectrum,
     mesh_frequency_hz: float | None = None,
@@ -143,66 +147,123 @@ def spectrum_figure(
 ) -> Figure:
     """The figure of :func:`plot_spectrum` (same arguments but ``path``), not saved.
 
-    Amplitude spectrum against frequency [Hz] (as Figs. 13-16, 20).
-
-    Mesh harmonics k f_z <= fmax_hz (at most ``max_harmonics``) are marked by dashed lines labelled
-    f_z, 2f_z, ... (aligned inwards at the edges); shaft frequencies by green lines named with their
-    frequency in a legend by the mapping keys (plain text) or f_s1, f_s2, .... Long titles wrap.
-    ``log_amplitude`` uses a log y axis (bins below 1e-9 of the maximum are clipped to it).
-    Pass ``ylabel`` with the signal's unit, e.g. "Acceleration amplitude [m/s^2]".
+    Amplitude spectrum against frequency [Hz] (as Figs. 13-16, 20). Mesh harmonics k f_z <= fmax_hz
+    (at most ``max_harmonics``) are marked by dashed lines labelled f_z, 2f_z, ... inside the axes.
+    Shaft frequencies, a few Hz on an axis of kHz, get a second, low-frequency panel below (0 to
+    :data:`SHAFT_PANEL_ORDERS` times the fastest shaft, shaded in the upper panel) where they are marked
+    by green lines labelled inside it with the mapping keys (plain text) or f_s1, f_s2, ... and their
+    frequency. Long titles wrap. ``log_amplitude`` uses log y axes (bins below 1e-9 of the maximum are
+    clipped to it). Pass ``ylabel`` with the signal's unit, e.g. "Acceleration amplitude [m/s^2]".
     """
     fmax = float(spectrum.frequency_hz[-1]) if fmax_hz is None else float(fmax_hz)
     shown = spectrum.frequency_hz <= fmax
     freq = spectrum.frequency_hz[shown]
     amp = spectrum.amplitude[shown]
-
-    fig = new_figure(size_px, dpi)
-    ax = fig.add_subplot()
     if log_amplitude:
         peak = float(np.max(amp)) if amp.size and np.max(amp) > 0 else 1.0
         amp = np.maximum(amp, peak * 1e-9)
-        ax.set_yscale("log")
-    ax.plot(freq, amp, color="tab:blue", linewidth=0.8)
-    label_transform = ax.get_xaxis_transform()  # x in data, y in axes fraction
-
-    if mesh_frequency_hz is not None:
-        harmonics = mesh_harmonics(mesh_frequency_hz, fmax)[:max_harmonics]
-        for f, label in zip(harmonics, harmonic_labels(harmonics.size), strict=True):
-            ax.axvline(f, color="tab:red", linestyle="--", linewidth=0.8, alpha=0.8)
-            # a label at either edge of the axes is aligned inwards, so that it stays in the figure
-            align = "right" if f > 0.97 * fmax else "left" if f < 0.03 * fmax else "center"
-            ax.text(
-                f,
-                1.0,
-                f"${label}$",
-                transform=label_transform,
-                ha=align,
-                va="bottom",
-                color="tab:red",
-                fontsize=8,
-                clip_on=False,
-            )
 
     if isinstance(shaft_frequencies_hz, Mapping):
         shafts = [(str(k), float(v)) for k, v in shaft_frequencies_hz.items()]
     else:
         shafts = [(f"$f_{{s{i}}}$", float(v)) for i, v in enumerate(shaft_frequencies_hz, start=1)]
-    shown_shafts = [(label, f) for label, f in shafts if f <= fmax]
-    styles = (":", "-.", (0, (1, 3)), (0, (5, 2, 1, 2)))
-    for i, (label, f) in enumerate(shown_shafts):
-        # shaft lines lie close together at the low end: named in a legend, not next to the line
-        style = styles[i % len(styles)]
-        ax.axvline(f, color="tab:green", linestyle=style, linewidth=1.0, label=f"{label} = {f:.4g} Hz")
-    if shown_shafts:
-        ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    shown_shafts = sorted(((label, f) for label, f in shafts if 0.0 < f <= fmax), key=lambda s: s[1])
 
-    ax.set_xlim(0.0, fmax)
+    fig = new_figure(size_px, dpi)
+    if shown_shafts:
+        grid = fig.add_gridspec(2, 1, height_ratios=(2.4, 1.0))
+        ax, low = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])
+    else:
+        ax, low = fig.add_subplot(), None
+    _spectrum_axes(ax, freq, amp, log_amplitude, (0.0, fmax), ylabel)
+
+    marks: list[tuple] = []  # (axes, labels, colour): labelled once the layout is final
+    if mesh_frequency_hz is not None:
+        harmonics = mesh_harmonics(mesh_frequency_hz, fmax)[:max_harmonics]
+        names = harmonic_labels(harmonics.size)
+        for f in harmonics:
+            ax.axvline(f, color="tab:red", linestyle="--", linewidth=0.8, alpha=0.8)
+        marks.append((ax, [(f"${n}$", float(f)) for f, n in zip(harmonics, names, strict=True)], "tab:red"))
+
+    if low is not None:
+        f_low = min(fmax, SHAFT_PANEL_ORDERS * shown_shafts[-1][1])
+        inside = freq <= f_low
+        _spectrum_axes(low, freq[inside], amp[inside], log_amplitude, (0.0, f_low), ylabel)
+        resolution = f", bins of {freq[1] - freq[0]:.3g} Hz" if freq.size > 1 else ""
+        low.set_title(f"0-{f_low:.3g} Hz: shaft frequencies{resolution}", fontsize=9, pad=3)
+        ax.axvspan(0.0, f_low, color="tab:green", alpha=0.15, linewidth=0)
+        styles = (":", "-.", (0, (1, 3)), (0, (5, 2, 1, 2)))
+        for i, (_, f) in enumerate(shown_shafts):
+            low.axvline(f, color="tab:green", linestyle=styles[i % len(styles)], linewidth=1.2)
+        marks.append((low, [(f"{label} = {f:.4g} Hz", f) for label, f in shown_shafts], "tab:green"))
+
+    if title:
+        set_title(ax, title, pad=6)
+    fig.draw_without_rendering()  # the final layout: labels inside the axes are measured in it
+    for axes, labels, colour in marks:
+        _marker_labels(axes, labels, colour)
+    return fig
+
+
+def _spectrum_axes(ax, freq, amp, log_amplitude: bool, xlim: tuple[float, float], ylabel: str) -> None:
+    """The amplitude curve with room above it for the marker labels."""
+    if log_amplitude:
+        ax.set_yscale("log")
+    ax.plot(freq, amp, color="tab:blue", linewidth=0.8)
+    top, bottom = (float(np.max(amp)), float(np.min(amp))) if amp.size else (0.0, 0.0)
+    if top > max(bottom, 0.0):  # room above the peak: 12 % of the decades shown, or of the range
+        if log_amplitude:
+            ax.set_ylim(bottom, top * (top / bottom) ** 0.12)
+        else:
+            ax.set_ylim(min(0.0, bottom), top * 1.15)
+    ax.set_xlim(*xlim)
     ax.set_xlabel("Frequency f [Hz]")
     ax.set_ylabel(ylabel)
-    if title:
-        set_title(ax, title, pad=14 if mesh_frequency_hz is not None else 6)
     ax.grid(True, alpha=0.3)
-    return fig
+
+
+def _marker_labels(ax, labels: Sequence[tuple[str, float]], color: str) -> None:
+    """Each (text, frequency) at the top of ``ax``, inside it: centred on its line, or aligned inwards
+    near an edge; a label that would overlap the previous one goes one row lower."""
+    from matplotlib.transforms import blended_transform_factory
+
+    lo, hi = ax.get_xlim()
+    width = hi - lo
+    transform = blended_transform_factory(ax.transData, ax.transAxes)
+    fig = ax.get_figure()
+    renderer = fig.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    rows: list = []  # the extent of the last label of each row
+    for text, f in labels:
+        align = "right" if f > lo + 0.96 * width else "left" if f < lo + 0.04 * width else "center"
+        for row in range(len(rows) + 1):
+            label = ax.text(
+                f,
+                0.985 - 0.075 * row,
+                text,
+                transform=transform,
+                ha=align,
+                va="top",
+                color=color,
+                fontsize=8,
+                bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 0.5},
+                in_layout=False,
+            )
+            box = label.get_window_extent(renderer)
+            if box.x0 < frame.x0:  # aligned inwards, but wider than the room left: keep it inside
+                label.set_ha("left")
+                label.set_x(lo)
+            elif box.x1 > frame.x1:
+                label.set_ha("right")
+                label.set_x(hi)
+            box = label.get_window_extent(renderer)
+            if row == len(rows):
+                rows.append(box)
+                break
+            if box.x0 > rows[row].x1 + 2 or box.x1 < rows[row].x0 - 2:
+                rows[row] = box
+                break
+            label.remove()
 
 
 def plot_spectrum(

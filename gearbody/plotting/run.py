@@ -106,7 +106,7 @@ def _spectrum_plot(result: Result, out: Path, title: str) -> Path:
         shaft_frequencies_hz=shafts,
         title=f"{title}: spectrum of {name}, t = {t_win[0]:.3g}-{t_win[-1]:.3g} s"
         f" (last {result.FINAL_FRACTION:.0%} of the run, run-up left out)",
-        fmax_hz=min(result.sample_rate_hz / 2, 8 * f_mesh if f_mesh > 0 else 1e9),
+        fmax_hz=min(result.sample_rate_hz / 2, 8.5 * f_mesh if f_mesh > 0 else 1e9),
         ylabel=f"amplitude [{unit}]",
         log_amplitude=True,
     )

@@ -73,9 +73,12 @@ class WorkerDied(RuntimeError):
     """A pool worker process died (killed by a signal, crashed, or exited) while running a job."""
 
 
-def _ignore_sigint() -> None:
-    """Pool worker initializer: Ctrl-C reaches the whole process group; the parent stops the workers."""
+def _worker_signals() -> None:
+    """Pool worker initializer: Ctrl-C reaches the whole process group and the parent stops the workers,
+    so a worker ignores SIGINT; SIGTERM (how the parent stops them) gets its default action back, which a
+    forked worker would otherwise inherit as the command line's clean-stop handler."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _marked(marks: str, task: Task, jid: str, args: tuple) -> dict[str, Any]:
@@ -113,7 +116,7 @@ def run_pool(
     uncharged = 0
     try:
         while todo:
-            pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)), initializer=_ignore_sigint)
+            pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)), initializer=_worker_signals)
             futures: dict = {}
             processes: list = []
             broken = done = False

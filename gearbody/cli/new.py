@@ -1,0 +1,94 @@
+"""``gearbody new SCENE [--out FILE]``: a starting scenario for one's own drive, written from a scene.
+
+The file is the scene's fully resolved scenario (every key, in the canonical shape) with a comment on
+each key: meaning, unit, allowed range, default, and whether the scene set it, gearbody filled in its
+default or computed it (:mod:`gearbody.model.template`). ``gearbody run FILE`` takes it unchanged.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .common import EXIT_OK, add_set
+
+__all__ = ["register", "execute"]
+
+
+def register(sub) -> argparse.ArgumentParser:
+    """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    about = "write a commented starting scenario for your own drive from a scene"
+    parser = sub.add_parser(
+        "new",
+        help=about,
+        description=f"{about[0].upper()}{about[1:]}: the scene's fully resolved scenario as TOML, every"
+        " key with a comment giving its meaning, unit, allowed range, default and where its value"
+        " comes from (the scene, --set, gearbody's default, or resolved by gearbody). Edit it, then"
+        " 'gearbody run FILE'.",
+        epilog="example: gearbody new one-stage --out my-drive.toml && gearbody run my-drive.toml",
+    )
+    parser.add_argument("scene", metavar="SCENE", help="scene name (see 'gearbody list') or .toml path")
+    add_set(parser, "override a value before writing (as for run); the file says which keys were set")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        metavar="FILE",
+        help="the file to write (default: SCENE.toml in the current folder; '-': print it)",
+    )
+    parser.add_argument("--force", action="store_true", help="overwrite an existing FILE")
+    parser.set_defaults(handler=execute)
+    return parser
+
+
+def _scene_file(scene: str) -> Path:
+    from gearbody.model.scenes import scene_path
+
+    path = Path(scene)
+    return path if path.suffix or path.exists() else scene_path(scene)
+
+
+def execute(args) -> int:
+    from gearbody.errors import InputError
+    from gearbody.model import load_scenario
+    from gearbody.model.io import apply_overrides, read_toml
+    from gearbody.model.shorthand import canonical_form
+    from gearbody.model.template import commented_toml, header_comment
+    from gearbody.version import __version__
+
+    scenario = load_scenario(args.scene, args.overrides)  # refuses a bad scene or override (exit 2)
+    source = _scene_file(args.scene)
+    text = source.read_text()
+    given, _ = canonical_form(read_toml(source), str(source))
+    _, _, origins = apply_overrides(given, args.overrides)
+    out = args.out if args.out is not None else Path(f"{scenario.meta.name or source.stem}.toml")
+    command = "gearbody new " + " ".join([args.scene, *(f"--set {o}" for o in args.overrides)])
+    shown = "this file" if str(out) == "-" else out.name
+    intro = [
+        scenario.meta.title or scenario.meta.name,
+        "",
+        f"A starting scenario written by `{command}` (gearbody {__version__}) from {source.name}:",
+        "the fully resolved scenario, every key with a comment above it: meaning [unit]; allowed range;",
+        "default; and where the value comes from: set by the scene, set by --set, gearbody's default, or",
+        "resolved by gearbody (left as a comment, so that it follows your edits of the keys it comes",
+        "from). Keys that are not set are listed as comments too.",
+        f"Edit the values of your drive, then: gearbody run {shown}",
+        "Every key and equation: docs/scenario.md; sources of the published figures: docs/references.md.",
+    ]
+    document = commented_toml(
+        scenario, given=given, overridden=list(origins), intro=intro, scene_notes=header_comment(text)
+    )
+    if str(out) == "-":
+        sys.stdout.write(document)
+        return EXIT_OK
+    if out.is_dir():
+        raise InputError(f"--out {out}: is a folder, not a file")
+    if out.exists() and not args.force:
+        raise InputError(f"--out {out}: exists already; give --force to overwrite it, or another name")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(document)
+    except OSError as exc:
+        raise InputError(f"--out {out}: cannot write it: {exc.strerror or exc}") from None
+    print(f"wrote {out}: {scenario.meta.name} with every key commented; run it with: gearbody run {out}")
+    return EXIT_OK
