@@ -21,7 +21,7 @@ SCENES = list_scenes()
 T_END = "0.01"  # s: enough output samples for every plot's final window (20 kHz: 50 in the last 25 %)
 STUDY_T_END = "0.003"
 KEY = "condition.friction_coefficient"  # a key every drive has
-COVERED = {"list", "run", "modes", "mesh", "render", "validate", "sweep", "sensitivity", "calibrate"}
+COVERED = {"list", "new", "run", "modes", "mesh", "render", "validate", "sweep", "sensitivity", "calibrate"}
 
 
 def _is_planetary(stage) -> bool:
@@ -66,6 +66,15 @@ def test_run_writes_result_summary_report_and_every_stages_plots(scene, tmp_path
     assert expected <= written, expected - written
     assert written - expected <= {"bearing_forces.png"}, written - expected
     assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("scene", SCENES)
+def test_new_writes_a_starting_scenario_that_run_takes(scene, tmp_path, capsys):
+    drive = tmp_path / "my-drive.toml"
+    assert main(["new", scene, "--out", str(drive)]) == 0
+    out = tmp_path / "run"
+    assert main(["run", str(drive), "--t-end", "0.002", "--no-plots", "--quiet", "--out", str(out)]) == 0
+    assert (out / "summary.json").is_file()
 
 
 @pytest.mark.parametrize("scene", SCENES)
