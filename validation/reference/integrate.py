@@ -161,10 +161,18 @@ def _segment(rhs, t: float, tb: float, y, events, method: str, rtol: float, atol
     # A trial step that is too long for a stiff new mode can overflow inside its stages; the error norm
     # is then not finite and solve_ivp rejects the step and retries shorter (industrial-two-stage's
     # separation case did so 3 times). Those rejected stages are not results: silence their floating-
-    # point warnings here and check instead that every accepted state is finite.
+    # point warnings here and check instead that every accepted state is finite. A stage whose state has
+    # already overflowed gets a non-finite slope without calling rhs (whose math.cos would raise on inf:
+    # the conveyor's separation case with friction from the sliding velocity did).
+
+    def guarded(t, y):
+        if not np.all(np.isfinite(y)):
+            return np.full_like(y, np.nan)
+        return rhs(t, y)
+
     with np.errstate(over="ignore", invalid="ignore"):
         res = solve_ivp(
-            rhs,
+            guarded,
             (t, tb),
             y,
             method=method,
