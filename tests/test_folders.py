@@ -1,0 +1,197 @@
+"""A results folder is one run (issue 26): a command writes into a folder only if it is empty, holds
+the same run, or ``--overwrite`` replaces it (the old outputs removed first); two commands on one
+folder are serialised by a lock, which a killed command never leaves blocking; a full disk is one line
+naming the file (exit 1), with nothing half-written recorded as done.
+
+Full disk: where this process may mount (root), a small tmpfs made by the test itself, filled to a few
+pages; everywhere, ENOSPC simulated by :func:`_disk_full_at` (``os.replace`` of the named file fails
+with ENOSPC after its temporary file is written) or, for the appended calibration record, by a write
+that stops half-way through a line."""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+import signal
+import subprocess
+import sys
+from contextlib import contextmanager
+from fnmatch import fnmatch
+from pathlib import Path
+
+import pytest
+from gearbody.errors import FolderInUse, InputError, OutputError
+from gearbody.folders import LOCK, MANIFEST, FolderLock, atomic_write, claim, inspect
+
+RUN = ["--t-end", "0.02", "--quiet"]
+STEADY = ["--set", 'operation.initial_state="steady"']
+SMALL_RENDER = ["--frames", "2", "--width", "80", "--height", "60", "--quiet"]
+
+
+def _one_line(err: str) -> str:
+    """The single line of an error output (no traceback)."""
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    return err.strip()
+
+
+def _listing(folder: Path) -> dict[str, int]:
+    """``{name: mtime_ns}`` of every entry in ``folder``."""
+    return {p.name: p.stat().st_mtime_ns for p in folder.iterdir()}
+
+
+def _temporary(folder: Path) -> list[Path]:
+    return [p for p in folder.rglob(".*.tmp*")]
+
+
+@contextmanager
+def _disk_full_at(monkeypatch, pattern: str, nth: int = 1):
+    """ENOSPC when the ``nth`` file whose name matches ``pattern`` is put in place (its temporary file
+    written, then the rename fails as a full disk would have failed the write)."""
+    real = os.replace
+    seen = []
+
+    def replace(src, dst, *args, **kwargs):
+        if fnmatch(Path(dst).name, pattern):
+            seen.append(dst)
+            if len(seen) == nth:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(src))
+        return real(src, dst, *args, **kwargs)
+
+    with monkeypatch.context() as m:
+        m.setattr(os, "replace", replace)
+        yield seen
+
+
+# -- the rules, without simulations ---------------------------------------------------------------------
+
+
+def test_atomic_write_on_a_full_disk_names_the_file_and_leaves_it_as_it_was(tmp_path):
+    target = tmp_path / "summary.json"
+    target.write_text("old")
+
+    def half_then_full(tmp: Path) -> None:
+        tmp.write_text('{"half": ')
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    with pytest.raises(OutputError) as caught:
+        atomic_write(target, half_then_full)
+    assert str(caught.value) == f"cannot write {target}: No space left on device (the disk is full)"
+    assert isinstance(caught.value, OSError) and caught.value.errno == errno.ENOSPC
+    assert target.read_text() == "old" and sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]
+
+
+def test_claim_rules_empty_same_other_foreign_and_overwrite(tmp_path):
+    run = {"scenario": {"meta": {"name": "one-stage"}, "operation": {"t_end_s": 0.02}}}
+    folder = tmp_path / "out"
+    (folder / "render").mkdir(parents=True)  # a subfolder (runs/SCENE/render) leaves it empty
+    (folder / ".DS_Store").write_text("")  # and so does a hidden file
+    with claim(folder, "run", run) as c:
+        assert c.mode == "new" and (folder / LOCK).is_file()
+        c.begin()
+        for name in ("result.npz", "summary.json", "report.html", "bearing_forces.png"):
+            (folder / name).write_text(name)
+        c.finish()
+    assert not (folder / LOCK).exists()  # removed when released
+    assert json.loads((folder / MANIFEST).read_text())["complete"] is True
+    with claim(folder, "run", run) as c:  # the same run: written again, the old outputs go first
+        assert c.mode == "same"
+        c.begin()
+        assert sorted(p.name for p in folder.iterdir()) == [".DS_Store", MANIFEST, LOCK, "render"]
+        (folder / "result.npz").write_text("new")
+        c.finish()
+    other = {"scenario": {"meta": {"name": "two-stage"}, "operation": {"t_end_s": 0.02}}}
+    with pytest.raises(InputError) as refused:
+        claim(folder, "run", other)
+    assert str(refused.value) == (
+        f"--out {folder} holds another run (meta.name: 'one-stage' there, 'two-stage' now); give "
+        "--overwrite to replace it, or choose another --out"
+    )
+    with pytest.raises(InputError, match=r"holds a 'gearbody run' result \(result.npz\); give --overwrite"):
+        claim(folder, "sweep")
+    (folder / "notes.txt").write_text("mine")
+    with claim(folder, "sweep", overwrite=True) as c:  # replaced: gearbody's outputs go, notes.txt stays
+        assert c.mode == "replace"
+        c.begin()
+    assert sorted(p.name for p in folder.iterdir()) == [".DS_Store", "notes.txt", "render"]
+    with pytest.raises(
+        InputError, match=r"is not empty: it holds files gearbody did not write \(notes.txt\)"
+    ):
+        claim(folder, "run", run)
+    assert not (folder / LOCK).exists()  # a refusal leaves no lock behind
+
+
+def test_inspect_tells_a_folder_written_without_a_manifest_by_its_files(tmp_path):
+    for files, kind in (
+        (["study.json"], "sweep"),
+        (["sensitivity.json"], "sensitivity"),
+        (["evaluations.jsonl"], "calibrate"),
+        (["frame_0000.png", "result.npz"], "render"),
+        (["mesh_stage1.png"], "mesh"),
+        (["result.npz", "kd_time.png", "a.txt"], "run"),
+        # an earlier gearbody rendered into a run folder: the run's files are gearbody outputs too
+        (["frame_0000.png", "summary.json", "kd_time.png", "result.npz"], "render-into-run"),
+    ):
+        folder = tmp_path / kind
+        folder.mkdir()
+        for name in files:
+            (folder / name).write_text("")
+        state = inspect(folder)
+        assert state.kind == kind.split("-")[0], kind
+        assert {p.name for p in state.outputs} == set(files) - {"a.txt"}, kind
+    assert inspect(tmp_path / "run").foreign == ("a.txt",)
+
+
+LOCK_HOLDER = """
+import os, sys, time
+from pathlib import Path
+from gearbody.folders import FolderLock
+FolderLock(Path(sys.argv[1]), "sweep").acquire()
+if len(sys.argv) > 2 and os.fork() == 0:  # a child (a pool worker) outlives its parent
+    time.sleep(60)
+    os._exit(0)
+print("locked", flush=True)
+time.sleep(60)
+"""
+
+
+def _hold_lock(folder: Path, fork: bool = False) -> subprocess.Popen:
+    proc = subprocess.Popen(
+        [sys.executable, "-c", LOCK_HOLDER, str(folder), *(["fork"] if fork else [])],
+        stdout=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    assert proc.stdout.readline().strip() == "locked"
+    return proc
+
+
+def test_a_locked_folder_is_refused_naming_the_holder_and_a_killed_holder_never_blocks(tmp_path):
+    holder = _hold_lock(tmp_path)
+    try:
+        with pytest.raises(FolderInUse) as busy:
+            FolderLock(tmp_path, "run").acquire()
+        assert str(busy.value) == (
+            f"--out {tmp_path}: another gearbody sweep (pid {holder.pid}) is writing in it; wait for it to "
+            "end, or choose another --out"
+        )
+    finally:
+        os.killpg(holder.pid, signal.SIGKILL)
+        holder.wait()
+    assert (tmp_path / LOCK).exists()  # left by the killed holder, and not in the way
+    with FolderLock(tmp_path, "run") as lock:
+        assert lock.fd is not None
+    assert not (tmp_path / LOCK).exists()
+
+
+def test_a_forked_child_does_not_keep_the_lock_of_its_killed_parent(tmp_path):
+    """A pool worker is a forked copy of the study's process: the lock must die with the study even if
+    a worker lives on."""
+    holder = _hold_lock(tmp_path, fork=True)
+    try:
+        os.kill(holder.pid, signal.SIGKILL)  # the parent only: its child sleeps on
+        holder.wait()
+        with FolderLock(tmp_path, "sweep"):
+            pass
+    finally:
+        os.killpg(holder.pid, signal.SIGKILL)
