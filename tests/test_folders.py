@@ -21,6 +21,7 @@ from fnmatch import fnmatch
 from pathlib import Path
 
 import pytest
+from gearbody.cli import main
 from gearbody.errors import FolderInUse, InputError, OutputError
 from gearbody.folders import LOCK, MANIFEST, FolderLock, atomic_write, claim, inspect
 
@@ -195,3 +196,106 @@ def test_a_forked_child_does_not_keep_the_lock_of_its_killed_parent(tmp_path):
             pass
     finally:
         os.killpg(holder.pid, signal.SIGKILL)
+
+
+# -- run, render, mesh ------------------------------------------------------------------------------------
+
+
+def test_run_of_another_scene_into_a_run_folder_is_refused_and_overwrite_replaces_it(tmp_path, capsys):
+    """Issue 26: the old scene's report.html and bearing_forces.png stayed beside the new result."""
+    out = tmp_path / "run"
+    assert main(["run", "lateral-6dof", *RUN, "--report", "--out", str(out)]) == 0
+    assert {"report.html", "bearing_forces.png", "summary.json"} <= set(os.listdir(out))
+    before = _listing(out)
+    capsys.readouterr()
+    assert main(["run", "one-stage", *RUN, "--out", str(out)]) == 2
+    line = _one_line(capsys.readouterr().err)
+    assert line.startswith(f"gearbody: invalid input: --out {out} holds another run (meta.name: ")
+    assert line.endswith("give --overwrite to replace it, or choose another --out")
+    assert _listing(out) == before  # nothing touched
+    assert main(["run", "one-stage", *RUN, "--overwrite", "--out", str(out)]) == 0
+    names = set(os.listdir(out))
+    assert "report.html" not in names and "bearing_forces.png" not in names
+    assert names == {MANIFEST, "result.npz", "scenario.toml", "summary.json"} | {
+        "kd_time.png",
+        "kd_folded.png",
+        "spectrum.png",
+    }
+    assert json.loads((out / "summary.json").read_text())["scene"] == "one-stage"
+    # the same run again (no --overwrite needed): the folder is what this command writes
+    assert main(["run", "one-stage", *RUN, "--no-plots", "--out", str(out)]) == 0
+    assert set(os.listdir(out)) == {MANIFEST, "result.npz", "scenario.toml", "summary.json"}
+    assert json.loads((out / MANIFEST).read_text())["complete"] is True
+
+
+def test_render_simulating_into_a_run_folder_is_refused_and_overwrite_leaves_no_run_files(tmp_path, capsys):
+    """Issue 26: render replaced result.npz and scenario.toml but kept the run's summary.json and plots."""
+    out = tmp_path / "run"
+    assert main(["run", "one-stage", *RUN, "--out", str(out)]) == 0
+    before = _listing(out)
+    capsys.readouterr()
+    assert main(["render", "one-stage", "--t-end", "0.03", *SMALL_RENDER, "--out", str(out)]) == 2
+    assert _one_line(capsys.readouterr().err) == (
+        f"gearbody: invalid input: --out {out} holds a 'gearbody run' result (kd_folded.png, kd_time.png, "
+        "result.npz and 3 more); give --overwrite to replace it, or choose another --out"
+    )
+    assert _listing(out) == before
+    render = ["render", "one-stage", "--t-end", "0.03", *SMALL_RENDER, "--overwrite", "--out", str(out)]
+    assert main(render) == 0
+    assert set(os.listdir(out)) == {
+        MANIFEST,
+        "result.npz",
+        "scenario.toml",
+        "frame_0000.png",
+        "frame_0001.png",
+        "animation.gif",
+    }
+    assert "t_end_s = 0.03" in (out / "scenario.toml").read_text()  # the render's run, not the old one
+
+
+def test_render_refuses_to_overwrite_the_result_it_reads(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["run", "one-stage", *RUN, "--no-plots", "--out", str(out)]) == 0
+    capsys.readouterr()
+    argv = ["render", "one-stage", "--result", str(out), *SMALL_RENDER, "--out", str(out), "--overwrite"]
+    assert main(argv) == 2
+    assert "which holds another run (--overwrite would remove it)" in _one_line(capsys.readouterr().err)
+    assert (out / "result.npz").is_file() and (out / "summary.json").is_file()
+
+
+def test_a_full_disk_in_render_names_the_frame_and_leaves_the_render_incomplete(
+    tmp_path, monkeypatch, capsys
+):
+    out = tmp_path / "render"
+    with _disk_full_at(monkeypatch, "frame_0001.png"):
+        assert main(["render", "one-stage", "--kinematic", *SMALL_RENDER, "--out", str(out)]) == 1
+    assert _one_line(capsys.readouterr().err) == (
+        f"gearbody: failed: cannot write {out}/frame_0001.png: No space left on device (the disk is full)"
+    )
+    assert not _temporary(out) and not (out / "animation.gif").exists()
+    assert json.loads((out / MANIFEST).read_text())["complete"] is False
+    assert main(["render", "one-stage", "--kinematic", *SMALL_RENDER, "--out", str(out)]) == 0  # same run
+    assert json.loads((out / MANIFEST).read_text())["complete"] is True and (out / "animation.gif").is_file()
+
+
+def test_a_full_disk_in_run_names_the_file_and_a_rerun_completes(tmp_path, monkeypatch, capsys):
+    out = tmp_path / "run"
+    with _disk_full_at(monkeypatch, "summary.json"):
+        assert main(["run", "one-stage", *RUN, "--no-plots", "--out", str(out)]) == 1
+    assert _one_line(capsys.readouterr().err) == (
+        f"gearbody: failed: cannot write {out}/summary.json: No space left on device (the disk is full)"
+    )
+    assert not (out / "summary.json").exists() and not _temporary(out)
+    assert json.loads((out / MANIFEST).read_text())["complete"] is False
+    assert main(["run", "one-stage", *RUN, "--no-plots", "--out", str(out)]) == 0
+    assert (out / "summary.json").is_file() and json.loads((out / MANIFEST).read_text())["complete"]
+
+
+def test_mesh_into_another_scenes_plots_is_refused_and_overwrite_leaves_no_stale_stage(tmp_path, capsys):
+    out = tmp_path / "mesh"
+    assert main(["mesh", "two-stage", "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["mesh", "one-stage", "--out", str(out)]) == 2
+    assert "holds another mesh (meta.name: 'two-stage' there, 'one-stage' now" in capsys.readouterr().err
+    assert main(["mesh", "one-stage", "--overwrite", "--out", str(out)]) == 0
+    assert sorted(os.listdir(out)) == [MANIFEST, "mesh_stage1.png"]  # no stage 2 of the other scene
