@@ -10,17 +10,20 @@ that stops half-way through a line."""
 
 from __future__ import annotations
 
+import builtins
 import errno
 import json
 import os
 import signal
 import subprocess
 import sys
+import time
 from contextlib import contextmanager
 from fnmatch import fnmatch
 from pathlib import Path
 
 import pytest
+
 from gearbody.cli import main
 from gearbody.errors import FolderInUse, InputError, OutputError
 from gearbody.folders import LOCK, MANIFEST, FolderLock, atomic_write, claim, inspect
@@ -299,3 +302,285 @@ def test_mesh_into_another_scenes_plots_is_refused_and_overwrite_leaves_no_stale
     assert "holds another mesh (meta.name: 'two-stage' there, 'one-stage' now" in capsys.readouterr().err
     assert main(["mesh", "one-stage", "--overwrite", "--out", str(out)]) == 0
     assert sorted(os.listdir(out)) == [MANIFEST, "mesh_stage1.png"]  # no stage 2 of the other scene
+
+
+# -- studies ------------------------------------------------------------------------------------------------
+
+SWEEP = [
+    "sweep",
+    "one-stage",
+    "--vary",
+    "production.error_mode.e_um=0,10",
+    "--t-end",
+    "0.02",
+    "--workers",
+    "1",
+]
+
+
+def test_a_study_refuses_a_run_folder_and_a_run_refuses_a_study_folder(tmp_path, capsys):
+    run, study = tmp_path / "run", tmp_path / "study"
+    assert main(["run", "one-stage", *RUN, "--no-plots", "--out", str(run)]) == 0
+    capsys.readouterr()
+    assert main([*SWEEP, "--quiet", "--out", str(run)]) == 2
+    assert (
+        "holds a 'gearbody run' result (result.npz, scenario.toml, summary.json)" in capsys.readouterr().err
+    )
+    assert main([*SWEEP, "--quiet", "--out", str(study)]) == 0
+    capsys.readouterr()
+    calibrate = ["calibrate", "one-stage", "--param", "design.mesh.damping_Ns_per_m=3000:12000"]
+    for argv in (["run", "one-stage", *RUN], [*calibrate, "--target", "kd_max", "1", "0.1"]):
+        assert main([*argv, "--out", str(study)]) == 2
+        assert f"--out {study} holds a 'gearbody sweep' study (cases, " in _one_line(capsys.readouterr().err)
+
+
+def test_two_sweeps_on_one_folder_the_second_is_refused_and_the_first_completes(tmp_path, capsys):
+    """Issue 26: one of two sweeps on one --out died with FileNotFoundError (each deleted the other's live
+    temporary files as stale). Now the second is refused in one line while the first runs."""
+    out = tmp_path / "sweep"
+    argv = [*SWEEP[:3], "production.error_mode.e_um=0:20:6", "--t-end", "0.3", "--workers", "1"]
+    first = subprocess.Popen(
+        [sys.executable, "-m", "gearbody.cli", *argv, "--quiet", "--out", str(out)],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        deadline = time.monotonic() + 120
+        while not (out / "cases" / "case-0000" / "summary.json").exists():  # mid-study, lock held
+            assert first.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        assert main([*argv, "--quiet", "--out", str(out)]) == 2
+        assert first.poll() is None  # still running: the refusal happened while it held the folder
+    finally:
+        _, err = first.communicate(timeout=300)
+    assert _one_line(capsys.readouterr().err) == (
+        f"gearbody: invalid input: --out {out}: another gearbody sweep (pid {first.pid}) is writing in it; "
+        "wait for it to end, or choose another --out"
+    )
+    assert first.returncode == 0 and err == ""
+    summaries = sorted((out / "cases").glob("*/summary.json"))
+    assert len(summaries) == 6 and not (out / LOCK).exists() and not _temporary(out)
+
+
+def test_a_sweep_killed_with_sigkill_leaves_no_lock_in_the_way_of_its_resume(tmp_path, capsys):
+    out = tmp_path / "sweep"
+    argv = [*SWEEP[:3], "production.error_mode.e_um=0:20:6", "--t-end", "0.3", "--workers", "1"]
+    first = subprocess.Popen([sys.executable, "-m", "gearbody.cli", *argv, "--quiet", "--out", str(out)])
+    deadline = time.monotonic() + 120
+    while not (out / "cases" / "case-0000" / "summary.json").exists():
+        assert first.poll() is None and time.monotonic() < deadline
+        time.sleep(0.05)
+    first.kill()
+    first.wait()
+    assert (out / LOCK).exists()  # the killed process could not remove it; the kernel released it
+    assert main([*argv, "--out", str(out)]) == 0
+    assert "cases already done" in capsys.readouterr().err
+    assert len(list((out / "cases").glob("*/summary.json"))) == 6
+
+
+def test_a_full_disk_in_a_sweep_keeps_the_cases_recorded_and_the_resume_completes(
+    tmp_path, monkeypatch, capsys
+):
+    out = tmp_path / "sweep"
+    with _disk_full_at(monkeypatch, "summary.json", nth=2):  # the second case's record
+        assert main([*SWEEP, "--quiet", "--out", str(out)]) == 1
+    case = out / "cases" / "case-0001"
+    assert _one_line(capsys.readouterr().err) == (
+        f"gearbody: failed: cannot write {case}/summary.json: No space left on device (the disk is full); "
+        "1 of 2 cases recorded: make room and rerun the same command to resume"
+    )
+    assert (out / "cases" / "case-0000" / "summary.json").is_file()
+    assert (case / "result.npz").is_file() and not (case / "summary.json").exists()  # not done
+    assert not _temporary(out) and not (out / "summary.csv").exists()
+    assert main([*SWEEP, "--out", str(out)]) == 0
+    assert "resuming" in capsys.readouterr().err and (case / "summary.json").is_file()
+
+
+SENSITIVITY = [
+    "sensitivity",
+    "one-stage",
+    "--key",
+    "design.mesh.damping_Ns_per_m=3000:12000",
+    "--feature",
+    "kd_max",
+    "--samples",
+    "2",
+    "--t-end",
+    "0.02",
+    "--workers",
+    "1",
+]
+
+
+def test_a_full_disk_in_a_sensitivity_analysis_keeps_the_rows_recorded(tmp_path, monkeypatch, capsys):
+    out = tmp_path / "sens"
+    with _disk_full_at(monkeypatch, "row-*.json", nth=3):
+        assert main([*SENSITIVITY, "--quiet", "--out", str(out)]) == 1
+    line = _one_line(capsys.readouterr().err)
+    assert line.startswith(f"gearbody: failed: cannot write {out}/evaluations/row-000002.json: No space left")
+    assert line.endswith(
+        "2 of the 4 runs of this call recorded: make room and rerun the same command to resume"
+    )
+    assert sorted(p.name for p in (out / "evaluations").iterdir()) == ["row-000000.json", "row-000001.json"]
+    assert main([*SENSITIVITY, "--out", str(out)]) == 0
+    assert "2 of 4 rows already recorded" in capsys.readouterr().err
+
+
+def test_a_sensitivity_analysis_refuses_another_one_and_overwrite_replaces_it(tmp_path, capsys):
+    out = tmp_path / "sens"
+    assert main([*SENSITIVITY, "--quiet", "--out", str(out)]) == 0
+    other = [*SENSITIVITY[:3], "design.mesh.damping_Ns_per_m=4000:12000", *SENSITIVITY[4:]]
+    capsys.readouterr()
+    assert main([*other, "--quiet", "--out", str(out)]) == 2
+    assert "holds a different sensitivity analysis" in _one_line(capsys.readouterr().err)
+    assert main([*other, "--quiet", "--overwrite", "--out", str(out)]) == 0
+    spec = json.loads((out / "sensitivity.json").read_text())["spec"]
+    assert spec["bounds"] == [[4000.0, 12000.0]]
+
+
+CALIBRATE = [
+    "calibrate",
+    "one-stage",
+    "--t-end",
+    "0.02",
+    "--target",
+    "kd_max",
+    "1.5",
+    "0.1",
+    "--budget",
+    "2",
+    "--polish-evaluations",
+    "0",
+    "--workers",
+    "1",
+    "--quiet",
+]
+DAMPING = ["--param", "design.mesh.damping_Ns_per_m=3000:12000"]
+
+
+def test_calibrate_into_another_calibration_and_a_damaged_record_are_one_line(tmp_path, capsys):
+    """Issue 26: another calibration's folder was a CalibrationError traceback (exit 1), a corrupt
+    evaluations.jsonl a JSONDecodeError."""
+    out = tmp_path / "cal"
+    assert main([*CALIBRATE, *DAMPING, "--out", str(out)]) == 0
+    record = out / "evaluations.jsonl"
+    lines = record.read_text().splitlines()
+    capsys.readouterr()
+    stiffness = ["--param", "design.mesh.stiffness_single_N_per_m=1e9:2e9"]
+    assert main([*CALIBRATE, *stiffness, "--out", str(out)]) == 2
+    assert _one_line(capsys.readouterr().err) == (
+        f"gearbody calibrate: --out {out} holds a record that is not this calibration's: {record}: records "
+        "another calibration (a different scene, parameters, targets or settings); rerun with the same "
+        "arguments to resume, give --overwrite to replace it, or choose another --out"
+    )
+    assert record.read_text().splitlines() == lines
+    # lines that are no whole evaluation are dropped (those points evaluated again), not a traceback
+    record.write_text("\n".join([lines[0], "[1, 2]", lines[1], '{"point": 3}', "{not json", lines[2][:20]]))
+    assert main([*CALIBRATE, *DAMPING, "--out", str(out)]) == 0
+    assert json.loads((out / "calibration.json").read_text())["replayed"] >= 1
+    kept = record.read_text().splitlines()
+    assert kept[:2] == lines[:2] and all(json.loads(x)["point"] for x in kept[1:])
+    record.write_text("{not a record\n" + "\n".join(lines[1:]) + "\n")
+    capsys.readouterr()
+    assert main([*CALIBRATE, *DAMPING, "--out", str(out)]) == 2
+    assert _one_line(capsys.readouterr().err).endswith(
+        "its first line is not a gearbody calibration record; give --overwrite to replace it, or choose "
+        "another --out"
+    )
+    assert main([*CALIBRATE, *stiffness, "--overwrite", "--out", str(out)]) == 0
+    assert (
+        json.loads(record.read_text().splitlines()[0])["fingerprint"] != json.loads(lines[0])["fingerprint"]
+    )
+
+
+def test_a_full_disk_in_a_calibration_cuts_no_recorded_evaluation(tmp_path, monkeypatch, capsys):
+    """ENOSPC half-way through the second evaluation's line: one line naming the record; the resume
+    drops the cut line, replays the whole one and ends as an uninterrupted calibration."""
+    out = tmp_path / "cal"
+    from gearbody.studies import calibration
+
+    appended = []
+
+    def full_open(path, mode="r", *args, **kwargs):
+        f = builtins.open(path, mode, *args, **kwargs)
+        if mode != "a":
+            return f
+        appended.append(path)
+        if len(appended) < 2:
+            return f
+
+        class Full:
+            def __enter__(self):
+                return self
+
+            def __exit__(self, *exc):
+                f.close()
+
+            def write(self, text):
+                f.write(text[: len(text) // 2])
+                f.flush()
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+        return Full()
+
+    with monkeypatch.context() as m:
+        m.setattr(calibration, "open", full_open, raising=False)
+        assert main([*CALIBRATE, *DAMPING, "--out", str(out)]) == 1
+    record = out / "evaluations.jsonl"
+    assert _one_line(capsys.readouterr().err) == (
+        f"gearbody: failed: cannot write {record}: No space left on device (the disk is full); the "
+        f"evaluations recorded in {record} stay: make room and rerun the same command to resume"
+    )
+    assert not record.read_text().endswith("\n") and not (out / "calibration.json").exists()
+    assert main([*CALIBRATE, *DAMPING, "--out", str(out)]) == 0
+    resumed = json.loads((out / "calibration.json").read_text())
+    clean = tmp_path / "clean"
+    assert main([*CALIBRATE, *DAMPING, "--out", str(clean)]) == 0
+    uninterrupted = json.loads((clean / "calibration.json").read_text())
+    assert resumed["replayed"] == 1 and resumed["parameters"] == uninterrupted["parameters"]
+
+
+# -- a real full disk: a small filesystem the test mounts ---------------------------------------------------
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 1 MiB tmpfs mounted in tmp_path (root only), and a function that fills it to ``pages`` free."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=1m", "tmpfs", str(disk)], capture_output=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a small filesystem here: {done.stderr.decode().strip()[:100]}")
+    filler = disk / "filler"
+
+    def fill(pages: int) -> None:
+        st = os.statvfs(disk)
+        filler.write_bytes(b"\0" * max(0, (st.f_bavail - pages) * st.f_bsize))
+
+    try:
+        yield disk, fill, filler
+    finally:
+        subprocess.run(["umount", "-l", str(disk)], check=False)
+
+
+def test_a_real_full_disk_in_run_and_in_a_sweep_is_one_line_and_resumable(small_disk, capsys):
+    disk, fill, filler = small_disk
+    run, sweep = disk / "run", disk / "sweep"
+    fill(pages=4)
+    assert main(["run", "one-stage", *RUN, "--out", str(run)]) == 1
+    line = _one_line(capsys.readouterr().err)
+    assert line.startswith(f"gearbody: failed: cannot write {run}/") and line.endswith(
+        ": No space left on device (the disk is full)"
+    )
+    assert not _temporary(run) and not (run / "summary.json").exists()
+    assert not json.loads((run / MANIFEST).read_text())["complete"]
+    assert main([*SWEEP, "--quiet", "--out", str(sweep)]) == 1
+    line = _one_line(capsys.readouterr().err)
+    assert line.startswith(f"gearbody: failed: cannot write {sweep}/cases/case-0000/")
+    assert line.endswith("0 of 2 cases recorded: make room and rerun the same command to resume")
+    assert not list(sweep.glob("cases/*/summary.json")) and not _temporary(sweep)
+    filler.unlink()  # room again: both resume
+    assert main(["run", "one-stage", *RUN, "--out", str(run)]) == 0
+    assert json.loads((run / MANIFEST).read_text())["complete"]
+    assert main([*SWEEP, "--quiet", "--out", str(sweep)]) == 0
+    assert len(list(sweep.glob("cases/*/summary.json"))) == 2
