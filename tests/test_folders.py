@@ -584,3 +584,14 @@ def test_a_real_full_disk_in_run_and_in_a_sweep_is_one_line_and_resumable(small_
     assert json.loads((run / MANIFEST).read_text())["complete"]
     assert main([*SWEEP, "--quiet", "--out", str(sweep)]) == 0
     assert len(list(sweep.glob("cases/*/summary.json"))) == 2
+
+
+def test_an_oserror_no_writer_names_is_one_line_exit_1(monkeypatch, capsys):
+    from gearbody.cli import listing
+
+    def broken(args):
+        raise OSError(errno.EIO, os.strerror(errno.EIO), "/data/scenes.toml")
+
+    monkeypatch.setattr(listing, "execute", broken)
+    assert main(["list"]) == 1
+    assert _one_line(capsys.readouterr().err) == "gearbody: failed: /data/scenes.toml: Input/output error"
