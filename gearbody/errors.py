@@ -47,6 +47,19 @@ class RenderError(InputError):
     """A picture or animation cannot be made from the given options or result (exit code 2)."""
 
 
+class FolderInUse(InputError):
+    """Another gearbody command is writing in the output folder (exit code 2): the message names its
+    command and pid (:mod:`gearbody.folders`)."""
+
+
+class OutputError(GearbodyError, OSError):
+    """A file could not be written (a full disk, a lost permission; exit code 1): the message names it.
+    Nothing half-written is left under its name (:func:`gearbody.folders.atomic_write`). Also an
+    ``OSError`` with the original ``errno``."""
+
+    exit_code = 1
+
+
 class StudyError(GearbodyError):
     """A parameter study cannot run as specified (its specification or its store)."""
 
@@ -71,8 +84,10 @@ class ReferenceMismatch(GearbodyError):
 
 __all__ = [
     "CalibrationFailed",
+    "FolderInUse",
     "GearbodyError",
     "InputError",
+    "OutputError",
     "ReferenceMismatch",
     "RenderError",
     "ScenarioError",

@@ -151,10 +151,11 @@ def test_cli_hand_given_scene_and_train(tmp_path, capsys):
     assert main(["mesh", "two-stage", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     assert "stage 1 of 2 (design.stages.1)" in text and "stage 2 of 2 (design.stages.2)" in text
-    assert sorted(p.name for p in out.iterdir()) == ["mesh_stage1.png", "mesh_stage2.png"]
+    # .gearbody.json: what wrote the folder (gearbody.folders), so that a rerun knows its own plots
+    assert sorted(p.name for p in out.iterdir()) == [".gearbody.json", "mesh_stage1.png", "mesh_stage2.png"]
     only = tmp_path / "only"
     assert main(["mesh", "two-stage", "--stage", "2", "--out", str(only)]) == 0
-    assert [p.name for p in only.iterdir()] == ["mesh_stage2.png"]
+    assert sorted(p.name for p in only.iterdir()) == [".gearbody.json", "mesh_stage2.png"]
 
 
 def test_cli_refuses_bad_stage_and_load(capsys):

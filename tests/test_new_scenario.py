@@ -105,12 +105,14 @@ def test_set_overrides_are_written_and_marked(tmp_path):
     assert load_scenario(out).stages[0].error_mode.e_um == 15.0
 
 
-def test_an_existing_file_is_kept_unless_forced_and_dash_prints(tmp_path, capsys):
+def test_an_existing_file_is_kept_unless_overwritten_and_dash_prints(tmp_path, capsys):
     out = _new(tmp_path, "two-wheel")
     out.write_text("mine")
     assert main(["new", "two-wheel", "--out", str(out)]) == 2
-    assert f"--out {out}: exists already; give --force" in capsys.readouterr().err
+    assert f"--out {out}: exists already; give --overwrite" in capsys.readouterr().err
     assert out.read_text() == "mine"
+    assert main(["new", "two-wheel", "--out", str(out), "--overwrite"]) == 0 and out.read_text() != "mine"
+    out.write_text("mine")  # --force: the earlier name of --overwrite, still understood
     assert main(["new", "two-wheel", "--out", str(out), "--force"]) == 0 and out.read_text() != "mine"
     capsys.readouterr()
     assert main(["new", "two-wheel", "--out", "-"]) == 0

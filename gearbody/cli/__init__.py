@@ -3,8 +3,10 @@ render``.
 
 One module per command (``register(sub)`` adds its parser, ``execute(args)`` runs it; heavy imports
 happen inside ``execute``), the shared options and exit codes in :mod:`.common`. Exit codes: 0 ok,
-1 something failed (validation, sweep cases), 2 bad input (invalid scenario or option), 3 simulation
-failed, 130 interrupted (Ctrl-C: one line, no traceback), 143 stopped by SIGTERM (the same clean stop).
+1 something failed (validation, sweep cases, a file that cannot be written: a full disk, named in one
+line), 2 bad input (invalid scenario or option, an output folder holding another run or in use by
+another command), 3 simulation failed, 130 interrupted (Ctrl-C: one line, no traceback), 143 stopped by
+SIGTERM (the same clean stop).
 
 Signals: an inherited SIGINT disposition is kept (a job started with ``cmd &`` from a script ignores
 Ctrl-C on purpose, and so does gearbody); SIGTERM, the way to stop such a job (``kill PID``), stops a
@@ -21,7 +23,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 from . import calibrate, listing, mesh, modes, new, render, run, sensitivity, sweep, validate
-from .common import EXIT_INTERRUPTED, EXIT_TERMINATED
+from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_TERMINATED
 
 __all__ = ["main"]
 
@@ -102,6 +104,10 @@ def main(argv: list[str] | None = None) -> int:
             )
             print(f"gearbody: {kind}: {exc}", file=sys.stderr)
             return exc.exit_code
+        except OSError as exc:  # a file gearbody's writers do not name themselves: one line all the same
+            where = f"{exc.filename}: " if exc.filename else ""
+            print(f"gearbody: failed: {where}{exc.strerror or exc}", file=sys.stderr)
+            return EXIT_FAILED
         except KeyboardInterrupt as exc:  # a study says how far it got (StudyInterrupted)
             print(str(exc) or f"interrupted: gearbody {args.command} stopped", file=sys.stderr)
             return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED

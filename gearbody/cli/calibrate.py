@@ -11,6 +11,7 @@ from .common import (
     EXIT_OK,
     add_executor,
     add_out,
+    add_overwrite,
     add_set,
     check_out,
     number,
@@ -34,7 +35,9 @@ def register(sub) -> argparse.ArgumentParser:
             "evaluation simulates each case its targets name. Writes DIR/evaluations.jsonl (every "
             "evaluation; rerunning the same command on DIR resumes it), DIR/calibration.json, "
             "calibration.md, convergence.png and calibrated.toml (the scene with the fitted values: "
-            "gearbody run DIR/calibrated.toml). Exit code 0: fit written; 1: every evaluation failed; 2: bad "
+            "gearbody run DIR/calibrated.toml). DIR holding anything else is refused unless --overwrite, "
+            "and so is a second calibration on DIR while one runs. Exit code 0: fit written; 1: every "
+            "evaluation failed, or a file could not be written (a full disk: rerun to resume); 2: bad "
             "input. See docs/calibration.md."
         ),
         epilog="example (recovers the mesh stiffness of one-stage, 1.2e9 N/m, from its 3rd natural "
@@ -107,6 +110,9 @@ def register(sub) -> argparse.ArgumentParser:
     ca.add_argument("--force", action="store_true", help="allow more evaluations than the limit (2000)")
     ca.add_argument("--quiet", action="store_true", help="no progress and no table")
     add_out(ca, "output folder of the calibration", required=True)
+    add_overwrite(
+        ca, "calibration (the fingerprint in its evaluations.jsonl: scene, --set, --case, features, --param)"
+    )
     ca.set_defaults(handler=execute)
     return ca
 
@@ -157,6 +163,7 @@ def execute(args) -> int:
             seed=args.seed,
             force=args.force,
             progress=not args.quiet,
+            overwrite=args.overwrite,
         )
     except (SweepSpecError, ImportError) as exc:
         return usage_error("calibrate", str(exc))

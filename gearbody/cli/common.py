@@ -23,6 +23,7 @@ __all__ = [
     "EXIT_USAGE",
     "add_executor",
     "add_out",
+    "add_overwrite",
     "add_set",
     "check_options",
     "check_out",
@@ -76,6 +77,16 @@ def add_executor(parser: argparse.ArgumentParser) -> None:
 def add_out(parser: argparse.ArgumentParser, help: str, required: bool = False) -> None:
     """``--out DIR`` into ``args.out`` (a Path)."""
     parser.add_argument("--out", type=Path, required=required, metavar="DIR", help=help)
+
+
+def add_overwrite(parser: argparse.ArgumentParser, same: str) -> None:
+    """``--overwrite`` into ``args.overwrite``; ``same`` says what makes a folder hold "the same run"."""
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace what DIR holds: its gearbody outputs are removed first (files other programs wrote "
+        f"stay). Without it DIR must be empty, or hold the same {same}; anything else is refused",
+    )
 
 
 def scenario_overrides(args) -> list[str]:

@@ -4,9 +4,20 @@ its figure (:mod:`gearbody.plotting.mesh`)."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 
-from .common import EXIT_OK, add_out, add_set, check_out, default_out, load, number, usage_error
+from .common import (
+    EXIT_OK,
+    add_out,
+    add_overwrite,
+    add_set,
+    check_out,
+    default_out,
+    load,
+    number,
+    usage_error,
+)
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -23,7 +34,8 @@ def register(sub) -> argparse.ArgumentParser:
             "pinion turn. A planetary stage: its teeth, radii and both planet meshes' table, k_z of the "
             "sun-planet and ring-planet law over the mesh cycle, each damaged tooth in the meshes it "
             "enters, and planet 1's static TE in each mesh. Evaluated with the solver's own mesh law, no "
-            "simulation. See docs/mesh.md."
+            "simulation. DIR must be empty, hold the plots of the same resolved scenario (drawn again) or "
+            "be replaced with --overwrite. See docs/mesh.md."
         ),
     )
     me.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
@@ -35,6 +47,7 @@ def register(sub) -> argparse.ArgumentParser:
         help="only stage N (1 = first in power-flow order; default: all)",
     )
     add_out(me, "output folder (default: runs/SCENE/mesh)")
+    add_overwrite(me, "scenario (scene and --set)")
     me.add_argument(
         "--load",
         type=number(ge=0),
@@ -49,6 +62,33 @@ def register(sub) -> argparse.ArgumentParser:
 
 def execute(args) -> int:
     out = None if args.no_plots else check_out(args.out or default_out(args.scene, "mesh"))
+    scenario = load(args.scene, args.overrides)
+    count = len(scenario.stages)
+    if args.stage is not None and not 1 <= args.stage <= count:
+        return usage_error(
+            "mesh", f"--stage = {args.stage}: {args.scene} has {count} stage(s); give 1..{count}"
+        )
+    if not (math.isfinite(args.load) and args.load >= 0):
+        return usage_error("mesh", f"--load = {args.load!r}: give a fraction >= 0 of the rated force")
+    stages = range(count) if args.stage is None else [args.stage - 1]
+    with contextlib.ExitStack() as stack:
+        if out is not None:  # locked while it writes; the old plots go first
+            from gearbody.folders import claim
+            from gearbody.model import scenario_to_dict
+
+            identity = {"scenario": scenario_to_dict(scenario)}
+            folder = stack.enter_context(claim(out, "mesh", identity, overwrite=args.overwrite))
+            folder.begin()
+        written = _report(args, scenario, stages, out)
+        if out is not None:
+            folder.finish()
+    if written:
+        print(f"wrote {', '.join(str(p) for p in written)}")
+    return EXIT_OK
+
+
+def _report(args, scenario, stages, out) -> list:
+    """Print each stage's report and write its plot in ``out`` (None: no plots); the plots written."""
     from gearbody.plotting.mesh import plot_planetary_stage, plot_stage
     from gearbody.reports.mesh import damage_windows, static_transmission_error, stiffness_cycle, summary_text
     from gearbody.reports.mesh.planetary import (
@@ -59,15 +99,6 @@ def execute(args) -> int:
         planetary_summary_text,
     )
 
-    scenario = load(args.scene, args.overrides)
-    count = len(scenario.stages)
-    if args.stage is not None and not 1 <= args.stage <= count:
-        return usage_error(
-            "mesh", f"--stage = {args.stage}: {args.scene} has {count} stage(s); give 1..{count}"
-        )
-    if not (math.isfinite(args.load) and args.load >= 0):
-        return usage_error("mesh", f"--load = {args.load!r}: give a fraction >= 0 of the rated force")
-    stages = range(count) if args.stage is None else [args.stage - 1]
     print(f"{scenario.meta.title}")
     written = []
     for k in stages:
@@ -84,6 +115,4 @@ def execute(args) -> int:
         print(summary_text(scenario, k, args.load, cycle=cycle, windows=windows, te=te))
         if path is not None:
             written.append(plot_stage(scenario, k, path, cycle, windows, te))
-    if written:
-        print(f"wrote {', '.join(str(p) for p in written)}")
-    return EXIT_OK
+    return written

@@ -36,7 +36,13 @@ def register(sub) -> argparse.ArgumentParser:
         metavar="FILE",
         help="the file to write (default: SCENE.toml in the current folder; '-': print it)",
     )
-    parser.add_argument("--force", action="store_true", help="overwrite an existing FILE")
+    parser.add_argument(
+        "--overwrite",
+        "--force",
+        dest="overwrite",
+        action="store_true",
+        help="replace an existing FILE (--force: the same, its earlier name)",
+    )
     parser.set_defaults(handler=execute)
     return parser
 
@@ -50,6 +56,7 @@ def _scene_file(scene: str) -> Path:
 
 def execute(args) -> int:
     from gearbody.errors import InputError
+    from gearbody.folders import write_text
     from gearbody.model import load_scenario
     from gearbody.model.io import apply_overrides, read_toml
     from gearbody.model.shorthand import canonical_form
@@ -83,12 +90,12 @@ def execute(args) -> int:
         return EXIT_OK
     if out.is_dir():
         raise InputError(f"--out {out}: is a folder, not a file")
-    if out.exists() and not args.force:
-        raise InputError(f"--out {out}: exists already; give --force to overwrite it, or another name")
+    if out.exists() and not args.overwrite:
+        raise InputError(f"--out {out}: exists already; give --overwrite to replace it, or another name")
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text(document)
     except OSError as exc:
         raise InputError(f"--out {out}: cannot write it: {exc.strerror or exc}") from None
+    write_text(out, document)  # atomic: a full disk leaves FILE as it was (OutputError naming it)
     print(f"wrote {out}: {scenario.meta.name} with every key commented; run it with: gearbody run {out}")
     return EXIT_OK

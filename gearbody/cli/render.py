@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import hashlib
 import time
 import zipfile
 from pathlib import Path
@@ -11,6 +13,7 @@ from pathlib import Path
 from .common import (
     EXIT_OK,
     add_out,
+    add_overwrite,
     add_set,
     check_out,
     default_out,
@@ -38,8 +41,10 @@ def register(sub) -> argparse.ArgumentParser:
             "software raytracer: no display needed. Without --result, SCENE is simulated first "
             "and its result.npz and scenario.toml are kept in DIR (--kinematic: rigid rotation, no "
             "simulation). Lateral gear motion is magnified by "
-            "--lateral-scale. --interactive replays in Exudyn's viewer instead (needs a display). "
-            "See docs/render.md."
+            "--lateral-scale. --interactive replays in Exudyn's viewer instead (needs a display). DIR "
+            "must be empty, hold a render of the same motion (the same resolved scenario, simulated, "
+            "--kinematic, or the same --result file: the frames are drawn again with the new options) or "
+            "be replaced with --overwrite. See docs/render.md."
         ),
     )
     rd.add_argument("scene", metavar="SCENE", help="scene name or .toml path")
@@ -67,6 +72,7 @@ def register(sub) -> argparse.ArgumentParser:
         "--end", type=number(ge=0), metavar="SECONDS", help="time of the last frame (default: end of result)"
     )
     add_out(rd, "output folder (default: runs/SCENE/render)")
+    add_overwrite(rd, "motion (resolved scenario, and simulated, --kinematic or the same --result)")
     rd.add_argument(
         "--format", choices=("gif", "mp4", "none"), default="gif", help="movie format (default gif)"
     )
@@ -123,6 +129,15 @@ def register(sub) -> argparse.ArgumentParser:
     return rd
 
 
+def _sha256(path: Path) -> str:
+    """The SHA-256 of a file (read in 1 MiB blocks)."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
 def execute(args) -> int:
     try:
         background = tuple(float(v) for v in args.background.split(","))
@@ -133,6 +148,7 @@ def execute(args) -> int:
     out_dir = args.out or default_out(args.scene, "render")
     if not args.interactive:
         check_out(out_dir)
+    from gearbody.folders import atomic_write, claim, read_manifest
     from gearbody.render import RenderError, RenderOptions, check_frames, render, view
     from gearbody.result import Result
 
@@ -148,6 +164,8 @@ def execute(args) -> int:
         housing=args.housing,
         background=background,
     )
+    folder = None
+    stack = contextlib.ExitStack()  # the claim on the output folder, released at the end
     try:
         options.check()
         if args.frames is not None:  # before anything is simulated
@@ -168,21 +186,45 @@ def execute(args) -> int:
                 raise RenderError(
                     f"--result = {args.result}: {path.name} is not a result written by 'gearbody run'"
                 ) from None
-        elif args.kinematic:
-            result = None
+            inside = not args.interactive and path.resolve().parent == out_dir.resolve()
+            # the same result file: the same motion; the result a render simulated into --out: its motion
+            motion = "simulated" if inside else f"result sha256 {_sha256(path)}"
         else:
+            motion = "kinematic" if args.kinematic else "simulated"
+        if not args.interactive:  # locked while it writes; the old outputs go just before the new ones
+            from gearbody.model import scenario_to_dict
+
+            identity = {"scenario": scenario_to_dict(scenario), "motion": motion}
+            recorded = read_manifest(out_dir) if args.result is not None and inside else None
+            if (
+                recorded
+                and recorded["command"] == "render"
+                and (recorded.get("identity") or {}).get("motion") == motion
+            ):
+                identity = recorded["identity"]  # its own simulated result, drawn again: the same run
+            folder = stack.enter_context(claim(out_dir, "render", identity, overwrite=args.overwrite))
+            if args.result is not None and inside and folder.mode != "same":
+                raise RenderError(
+                    f"--result = {args.result}: it is in --out {out_dir}, which holds another run "
+                    "(--overwrite would remove it); render into another --out"
+                )
+        if args.result is None and not args.kinematic:
             from gearbody.engine import simulate
 
             if not args.quiet:
                 print(f"simulating {args.scene} ({scenario.operation.t_end_s:g} s) ...")
             result = simulate(scenario, progress=not args.quiet)
             warn_if_backwards(result)
+        elif args.kinematic:
+            result = None
+        if folder is not None:  # the result read from --out stays (with its scenario.toml)
+            folder.begin(keep=[path, path.with_name("scenario.toml")] if args.result is not None else [])
         if args.result is None and not args.kinematic and not args.interactive:
             from gearbody.model import dump_scenario
 
-            out_dir.mkdir(parents=True, exist_ok=True)  # keep what was simulated: re-render with --result
-            result.save_npz(out_dir / "result.npz")
-            dump_scenario(scenario, out_dir / "scenario.toml")
+            # keep what was simulated: re-render with --result
+            atomic_write(out_dir / "result.npz", result.save_npz)
+            atomic_write(out_dir / "scenario.toml", lambda p: dump_scenario(scenario, p))
         if args.interactive:
             view(
                 scenario,
@@ -211,8 +253,11 @@ def execute(args) -> int:
             fps=args.fps,
             progress=not args.quiet,
         )
+        folder.finish()
     except RenderError as exc:
         return usage_error("render", str(exc))
+    finally:
+        stack.close()
     if not args.quiet:
         per = out.render_s / max(len(out.frames), 1)
         print(

@@ -10,6 +10,7 @@ import time
 from .common import (
     EXIT_OK,
     add_out,
+    add_overwrite,
     add_set,
     check_out,
     default_out,
@@ -34,7 +35,8 @@ def register(sub) -> argparse.ArgumentParser:
             "stage K_d over time and folded over the mesh period (stage k > 1: kd_time_stage_k.png, "
             "...), the spectrum of the pinion acceleration (lateral: housing acceleration) when the "
             "first stage is parallel, per planetary stage the planets' K_d, the load sharing and the "
-            "ring-sensor spectrum."
+            "ring-sensor spectrum. DIR must be empty, hold a run of the same resolved scenario (it is "
+            "written again) or be replaced with --overwrite; DIR/.gearbody.json records the run."
         ),
     )
     run.add_argument(
@@ -49,6 +51,7 @@ def register(sub) -> argparse.ArgumentParser:
         "--t-end", type=number(gt=0), metavar="SECONDS", help="simulated time (sets operation.t_end_s)"
     )
     add_out(run, "output folder (default: runs/SCENE)")
+    add_overwrite(run, "run (the same resolved scenario: scene, --set and --t-end)")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument(
         "--report",
@@ -72,23 +75,27 @@ PLANETARY_SHOWN = (
 def execute(args) -> int:
     out = check_out(args.out or default_out(args.scene))  # before anything is imported or run
     from gearbody.engine import simulate
-    from gearbody.model import dump_scenario
+    from gearbody.folders import atomic_write, claim, write_text
+    from gearbody.model import dump_scenario, scenario_to_dict
 
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
-    out.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
-    result = simulate(scenario, progress=not args.quiet)
-    result.save_npz(out / "result.npz")
-    dump_scenario(scenario, out / "scenario.toml")
-    summary = result.summary()
-    summary["wall_time_s"] = time.perf_counter() - t0
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    warn_if_backwards(result)
-    plots = [] if args.no_plots else result.plot(out)
-    if args.report:
-        from gearbody.reports.html import write_report
+    identity = {"scenario": scenario_to_dict(scenario)}  # what makes a run the same run
+    with claim(out, "run", identity, overwrite=args.overwrite) as folder:  # locked while it writes
+        t0 = time.perf_counter()
+        result = simulate(scenario, progress=not args.quiet)
+        folder.begin()  # the old outputs go; the run is recorded incomplete until every file is written
+        atomic_write(out / "result.npz", result.save_npz)
+        atomic_write(out / "scenario.toml", lambda p: dump_scenario(scenario, p))
+        summary = result.summary()
+        summary["wall_time_s"] = time.perf_counter() - t0
+        write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
+        warn_if_backwards(result)
+        plots = [] if args.no_plots else result.plot(out)
+        if args.report:
+            from gearbody.reports.html import write_report
 
-        write_report(result, out / "report.html")
+            write_report(result, out / "report.html")
+        folder.finish()
     if not args.quiet:
         print(f"{scenario.meta.title}")
         keys = (

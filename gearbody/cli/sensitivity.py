@@ -10,6 +10,7 @@ from .common import (
     EXIT_OK,
     add_executor,
     add_out,
+    add_overwrite,
     add_set,
     check_out,
     number,
@@ -29,9 +30,11 @@ def register(sub) -> argparse.ArgumentParser:
             "elementary-effect statistics (mu*, sigma) or Sobol indices (S1, ST, S2) with bootstrap "
             "confidence half-widths. Writes DIR/sensitivity.json, DIR/evaluations/<job>.json (one per "
             "run), DIR/indices.csv, indices.md, indices.json and indices.png. Rerunning the same command "
-            "on DIR resumes it. At most 2000 runs unless --force. Runs: Morris samples x (keys + 1), Sobol "
-            "samples x (2 keys + 2). Exit code 0: indices written; 1: runs failed (recorded; no "
-            "indices); 2: bad input. See docs/features.md."
+            "on DIR resumes it; DIR holding anything else is refused unless --overwrite, and so is a "
+            "second analysis on DIR while one runs. At most 2000 runs unless --force. Runs: Morris "
+            "samples x (keys + 1), Sobol samples x (2 keys + 2). Exit code 0: indices written; 1: runs "
+            "failed (recorded; no indices), or a file could not be written (a full disk: rerun to "
+            "resume); 2: bad input. See docs/features.md."
         ),
         epilog="examples:\n"
         "  gearbody sensitivity one-stage --key design.mesh.damping_Ns_per_m=3000:12000 \\\n"
@@ -85,6 +88,7 @@ def register(sub) -> argparse.ArgumentParser:
     )
     se.add_argument("--quiet", action="store_true", help="no progress bar and no table")
     add_out(se, "output folder of the analysis", required=True)
+    add_overwrite(se, "analysis (its sensitivity.json: scene, --set, --key, --feature, method, sample)")
     se.set_defaults(handler=execute)
     return se
 
@@ -113,6 +117,7 @@ def execute(args) -> int:
             retry_failed=args.retry_failed,
             exclude_failed=args.exclude_failed,
             progress=not args.quiet,
+            overwrite=args.overwrite,
         )
     except (SweepSpecError, FeatureError, ImportError) as exc:
         return usage_error("sensitivity", str(exc))

@@ -10,6 +10,7 @@ from .common import (
     EXIT_OK,
     add_executor,
     add_out,
+    add_overwrite,
     add_set,
     check_out,
     number,
@@ -31,8 +32,10 @@ def register(sub) -> argparse.ArgumentParser:
             "draws of the --random keys, times meta.seed = 1..N of --seeds. Writes DIR/study.json, "
             "DIR/cases/<id>/ (result.npz, scenario.toml, summary.json, or error.json), DIR/summary.csv "
             "and DIR/<value>_vs_<key>.png. Rerunning the same command on DIR resumes the study (after "
-            "Ctrl-C, or a killed run). A study has at most 10000 cases unless --max-cases allows more. "
-            "Exit code 0: all cases ran; 1: some failed; 2: bad input; 130: interrupted. See "
+            "Ctrl-C, or a killed run); DIR holding anything else is refused unless --overwrite, and so is "
+            "a second study on DIR while one runs. A study has at most 10000 cases unless --max-cases "
+            "allows more. Exit code 0: all cases ran; 1: some failed, or a file could not be written (a "
+            "full disk: the cases recorded stay, rerun to resume); 2: bad input; 130: interrupted. See "
             "docs/sweep.md."
         ),
         epilog="examples:\n"
@@ -95,6 +98,7 @@ def register(sub) -> argparse.ArgumentParser:
     sw.add_argument("--retry-failed", action="store_true", help="on resume, rerun the cases that failed")
     sw.add_argument("--quiet", action="store_true", help="no progress bar and no table")
     add_out(sw, "output folder of the study", required=True)
+    add_overwrite(sw, "study (its study.json: scene, --set, --vary, --random, --samples, seeds): resumed")
     sw.set_defaults(handler=execute)
     return sw
 
@@ -122,6 +126,7 @@ def execute(args) -> int:
             plot_value=args.plot_value,
             plot_key=args.plot_key,
             max_cases=args.max_cases,
+            overwrite=args.overwrite,
         )
     except (SweepSpecError, ImportError) as exc:
         return usage_error("sweep", str(exc))

@@ -14,6 +14,8 @@ import textwrap
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from gearbody.folders import atomic_write
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -82,11 +84,12 @@ def drop_overlapping(texts: list[Text], within: Axes | None = None) -> list[Text
 
 
 def save_figure(fig: Figure, path: PathLike, dpi: int = 100) -> Path:
-    """Write ``fig`` as PNG to ``path`` (parent folders created) at the requested pixel size."""
+    """Write ``fig`` as PNG to ``path`` (parent folders created) at the requested pixel size, atomically
+    (:func:`gearbody.folders.atomic_write`: OutputError naming ``path`` if it cannot be written)."""
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=dpi, format="png")  # no bbox_inches="tight": keeps the requested pixel size
-    return out
+    # no bbox_inches="tight": keeps the requested pixel size; atomic: a full disk leaves no part
+    return atomic_write(out, lambda tmp: fig.savefig(tmp, dpi=dpi, format="png"))
 
 
 def png_base64(fig: Figure, dpi: int = 100) -> str:

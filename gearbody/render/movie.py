@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import errno
 import shutil
 import subprocess
 from pathlib import Path
 
 import numpy as np
+
+from gearbody.folders import atomic_write
 
 from .poses import RenderError
 
@@ -14,10 +17,11 @@ FORMATS = ("gif", "mp4", "none")
 
 
 def write_png(image: np.ndarray, path: Path) -> Path:
+    """One frame as PNG, atomically (OutputError naming ``path`` if it cannot be written)."""
     from PIL import Image
 
-    Image.fromarray(np.asarray(image, dtype=np.uint8)).save(path, optimize=True)
-    return path
+    picture = Image.fromarray(np.asarray(image, dtype=np.uint8))
+    return atomic_write(path, lambda tmp: picture.save(tmp, format="PNG", optimize=True))
 
 
 def write_gif(frames: list[Path], path: Path, fps: float) -> Path:
@@ -30,15 +34,18 @@ def write_gif(frames: list[Path], path: Path, fps: float) -> Path:
     # one palette for all frames (from a mosaic of them) keeps colours steady between frames
     palette = images[0].quantize(colors=255, method=Image.Quantize.MEDIANCUT)
     quantised = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
-    quantised[0].save(
+    return atomic_write(
         path,
-        save_all=True,
-        append_images=quantised[1:],
-        duration=max(int(round(1000 / fps)), 20),
-        loop=0,
-        optimize=False,
+        lambda tmp: quantised[0].save(
+            tmp,
+            format="GIF",
+            save_all=True,
+            append_images=quantised[1:],
+            duration=max(int(round(1000 / fps)), 20),
+            loop=0,
+            optimize=False,
+        ),
     )
-    return path
 
 
 def ffmpeg_available() -> bool:
@@ -64,9 +71,13 @@ def write_mp4(frame_pattern: Path, path: Path, fps: float) -> Path:
         "yuv420p",
         "-c:v",
         "libx264",
-        str(path),
     ]
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise RenderError(f"ffmpeg failed ({done.returncode}): {done.stderr.strip()[:500]}")
-    return path
+
+    def encode(tmp: Path) -> None:
+        done = subprocess.run([*cmd, str(tmp)], capture_output=True, text=True)
+        if "No space left on device" in done.stderr:
+            raise OSError(errno.ENOSPC, "No space left on device", str(tmp))
+        if done.returncode != 0:
+            raise RenderError(f"ffmpeg failed ({done.returncode}): {done.stderr.strip()[:500]}")
+
+    return atomic_write(path, encode)

@@ -24,6 +24,7 @@ from gearbody.analysis import (
     peaks_to_rows,
     synchronous_average,
 )
+from gearbody.folders import write_text
 from gearbody.plotting.figure import png_base64
 from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure, tsa_figure
 from gearbody.result import Result
@@ -146,7 +147,8 @@ def report_sections(result: Result) -> dict[str, Any]:
 
 
 def write_report(result: Result, path: str | Path) -> Path:
-    """Write the report page for ``result`` to ``path`` (.html)."""
+    """Write the report page for ``result`` to ``path`` (.html), atomically (OutputError naming it if it
+    cannot be written)."""
     s = report_sections(result)
     title = html.escape(str(result.meta.get("title", result.meta.get("scene", "gearbody run"))))
     summary_rows = [{"quantity": k, "value": v} for k, v in s["summary"].items() if not isinstance(v, dict)]
@@ -178,6 +180,4 @@ def write_report(result: Result, path: str | Path) -> Path:
         _table([{"indicator": k, "value": v} for k, v in s["indicators"].items()]),
         "</body></html>",
     ]
-    path = Path(path)
-    path.write_text("\n".join(parts))
-    return path
+    return write_text(Path(path), "\n".join(parts))  # atomic: a full disk leaves no part

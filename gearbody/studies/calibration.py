@@ -35,6 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
+from gearbody.errors import InputError
+from gearbody.folders import output_error, write_text
+
 __all__ = [
     "CalibrationError",
     "CalibrationResult",
@@ -77,8 +80,9 @@ AT_BOUND_TOLERANCE = 1e-2
 ends on it: flagged in the result and warned about."""
 
 
-class CalibrationError(ValueError):
-    """A calibration that cannot be set up: bad bounds, no targets, an unknown cache."""
+class CalibrationError(InputError):
+    """A calibration that cannot be set up: bad bounds, no targets, an unknown cache (exit code 2; a
+    ``ValueError``)."""
 
 
 @dataclass(frozen=True)
@@ -141,7 +145,13 @@ class Target:
 
 class EvaluationCache:
     """Evaluations by parameter point, optionally persisted as JSON lines (one line per evaluation,
-    appended and flushed as it arrives: an interruption loses at most the evaluations in flight)."""
+    appended and flushed as it arrives: an interruption loses at most the evaluations in flight).
+
+    The first line holds the calibration's fingerprint: a file of another calibration, or one whose
+    first line is no gearbody record, is refused (:class:`CalibrationError`). A later line that is no
+    whole evaluation (cut by an interruption or a full disk, or damaged) is dropped, and that point is
+    evaluated again. A record that cannot be written raises :class:`~gearbody.errors.OutputError`
+    naming the file."""
 
     def __init__(self, path: str | Path | None = None, fingerprint: str = "") -> None:
         self.path = Path(path) if path is not None else None
@@ -149,38 +159,58 @@ class EvaluationCache:
         self.values: dict[str, dict[str, float] | None] = {}
         self.replayed = 0  # evaluations answered from the file read at the start
         self.recorded: set[str] = set()
-        if self.path is not None and self.path.exists():
-            lines = self.path.read_text().splitlines()
-            head = json.loads(lines[0]) if lines else {}
+        text = self._read() if self.path is not None else ""
+        head_start = '{"fingerprint": "'
+        if not (head_start.startswith(text) or (text.startswith(head_start) and "\n" not in text)):
+            lines = text.splitlines()
+            head = _record(lines[0])
+            if head is None or "fingerprint" not in head:
+                raise CalibrationError(f"{self.path}: its first line is not a gearbody calibration record")
             if head.get("fingerprint") != fingerprint:
                 raise CalibrationError(
                     f"{self.path}: records another calibration (a different scene, parameters, targets or "
-                    "settings); use another output folder or delete the file"
+                    "settings)"
                 )
             kept = lines[:1]
             for line in lines[1:]:
-                try:
-                    item = json.loads(line)
-                except json.JSONDecodeError:  # a line cut by an interruption: evaluated again
-                    continue
-                self.values[item["point"]] = item["features"]
+                item = _record(line)
+                point, features = (item or {}).get("point"), (item or {}).get("features", 0)
+                if not isinstance(point, str) or not (features is None or isinstance(features, dict)):
+                    continue  # a line cut by an interruption, or damaged: evaluated again
+                self.values[point] = features
                 kept.append(line)
             self.recorded = set(self.values)
-            if len(kept) < len(lines) or not self.path.read_text().endswith("\n"):
-                self.path.write_text("\n".join(kept) + "\n")  # new lines must not join a cut one
-        elif self.path is not None:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._append({"fingerprint": fingerprint})
+            if len(kept) < len(lines) or not text.endswith("\n"):  # new lines must not join a cut one
+                write_text(self.path, "\n".join(kept) + "\n")
+        elif self.path is not None:  # new, or its first line cut (a full disk when it was made): no record
+            try:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise output_error(self.path.parent, exc) from None
+            write_text(self.path, json.dumps({"fingerprint": fingerprint}) + "\n")
+
+    def _read(self) -> str:
+        """The record's text ('' if there is none)."""
+        try:
+            return self.path.read_text()
+        except FileNotFoundError:
+            return ""
+        except (OSError, UnicodeDecodeError) as exc:
+            reason = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
+            raise CalibrationError(f"{self.path}: cannot read it: {reason or exc}") from None
 
     @staticmethod
     def key(point: Mapping[str, float]) -> str:
         return json.dumps({k: float(v) for k, v in point.items()}, sort_keys=True)
 
     def _append(self, item: dict) -> None:
-        with open(self.path, "a") as f:
-            f.write(json.dumps(item) + "\n")
-            f.flush()
-            os.fsync(f.fileno())
+        try:
+            with open(self.path, "a") as f:
+                f.write(json.dumps(item) + "\n")
+                f.flush()
+                os.fsync(f.fileno())
+        except OSError as exc:  # a part of the line may be there: it is dropped when the file is read
+            raise output_error(self.path, exc) from None
 
     def evaluate(self, evaluate: Callable, points: list[dict[str, float]]) -> list[dict[str, float] | None]:
         """Features of every point: cached ones replayed, the others evaluated as one batch and recorded."""
@@ -195,6 +225,15 @@ class EvaluationCache:
                 if self.path is not None:
                     self._append({"point": keys[i], "features": features})
         return [self.values[k] for k in keys]
+
+
+def _record(line: str) -> dict | None:
+    """A JSON object of one line of the record, or None."""
+    try:
+        item = json.loads(line)
+    except ValueError:
+        return None
+    return item if isinstance(item, dict) else None
 
 
 @dataclass(frozen=True)

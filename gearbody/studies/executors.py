@@ -85,7 +85,10 @@ def _marked(marks: str, task: Task, jid: str, args: tuple) -> dict[str, Any]:
     """Run ``task(*args)`` in a pool worker with ``marks/<pid>`` naming the job while it runs (so the
     parent can tell which job a dead worker was running)."""
     mark = Path(marks) / str(os.getpid())
-    mark.write_text(jid)
+    try:
+        mark.write_text(jid)
+    except OSError:  # a full disk: the job runs unmarked (and its record will say why it stopped)
+        pass
     try:
         return task(*args)
     finally:

@@ -15,6 +15,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from gearbody.errors import OutputError
+from gearbody.folders import claim
 from gearbody.plotting.study import plot_study
 
 from .executors import check_options, run_jobs
@@ -53,6 +55,7 @@ def run_study(
     plot_value: str = DEFAULT_PLOT_VALUE,
     plot_key: str | None = None,
     max_cases: int = MAX_CASES,
+    overwrite: bool = False,
 ) -> StudyResult:
     """Run a parameter study, resuming whatever ``out_dir`` already holds of it.
 
@@ -69,9 +72,13 @@ def run_study(
         plot_value: summary value to plot (default ``kd_max_final``).
         plot_key: varied key on the x axis (default: the first one).
         max_cases: most cases the study may have (default :data:`~gearbody.studies.spec.MAX_CASES`).
+        overwrite: replace what ``out_dir`` holds (its gearbody outputs are removed first) instead of
+            resuming; without it, a folder holding anything but this study is refused.
     Raises:
         SweepSpecError, ScenarioError: bad input (also more than ``max_cases`` cases), before anything
-            runs.
+            runs; ``out_dir`` holds something else than this study (see ``overwrite``).
+        FolderInUse: another command is writing in ``out_dir`` (its lock, :mod:`gearbody.folders`).
+        OutputError: a file could not be written (a full disk); the cases written stay recorded.
         StudyInterrupted: Ctrl-C (a KeyboardInterrupt); the finished cases are recorded.
         ImportError: ``scheduler`` given but dask.distributed is not installed.
     """
@@ -100,67 +107,74 @@ def run_study(
     cases = study.cases()
     scenarios = {c.id: study.load_case(c) for c in cases}  # every case valid before anything runs
     out = Path(out_dir)
-    prepare_out(out, study, cases)
+    with claim(out, "sweep", overwrite=overwrite) as folder:  # locked while the study writes
+        folder.begin()
+        prepare_out(out, study, cases)
 
-    pending = []
-    for case in cases:
-        state, _ = case_state(out / "cases" / case.id)
-        if state == "pending" or (state == "failed" and retry_failed):
-            pending.append(case)
-    skipped = len(cases) - len(pending)
-    if progress and skipped:
-        print(f"resuming {out}: {skipped} of {len(cases)} cases already done", file=sys.stderr)
+        pending = []
+        for case in cases:
+            state, _ = case_state(out / "cases" / case.id)
+            if state == "pending" or (state == "failed" and retry_failed):
+                pending.append(case)
+        skipped = len(cases) - len(pending)
+        if progress and skipped:
+            print(f"resuming {out}: {skipped} of {len(cases)} cases already done", file=sys.stderr)
 
-    by_id = {c.id: c for c in pending}
-    jobs = [(c.id, (study.base, c.overrides, save_results)) for c in pending]
-    running = out / ".running"  # pool workers' <pid> files naming their case, while it runs
-    runner = run_jobs(run_case, jobs, workers=workers, scheduler=scheduler, mark_dir=running)
+        by_id = {c.id: c for c in pending}
+        jobs = [(c.id, (study.base, c.overrides, save_results)) for c in pending]
+        running = out / ".running"  # pool workers' <pid> files naming their case, while it runs
+        runner = run_jobs(run_case, jobs, workers=workers, scheduler=scheduler, mark_dir=running)
 
-    from tqdm import tqdm
+        from tqdm import tqdm
 
-    failed = 0
-    bar = None
-    recorded: set[str] = set()
-    try:
-        for cid, outcome in runner:
-            if cid in recorded:  # an executor never yields a case twice; never record one twice
-                continue
-            if bar is None:  # created after the pool has started its processes
-                bar = tqdm(
-                    total=len(jobs),
-                    desc="sweep",
-                    unit="case",
-                    disable=not progress,
-                    file=sys.stderr,
-                    bar_format="{desc}: {n_fmt}/{total_fmt} cases done{postfix} |{bar}| "
-                    "[{elapsed}<{remaining}]",
-                )
-                bar.set_postfix_str("0 failed", refresh=False)
-            write_case(out / "cases" / cid, by_id[cid], scenarios[cid], outcome, save_results)
-            recorded.add(cid)
-            failed += not outcome["ok"]
-            bar.set_postfix_str(f"{failed} failed", refresh=False)
-            bar.update(1)
-    except KeyboardInterrupt:
-        raise StudyInterrupted(skipped + len(recorded), len(cases)) from None
-    finally:
-        if bar is not None:
-            bar.close()
-        close = getattr(runner, "close", None)
-        if close:
-            close()
-        shutil.rmtree(running, ignore_errors=True)
+        failed = 0
+        bar = None
+        recorded: set[str] = set()
+        try:
+            for cid, outcome in runner:
+                if cid in recorded:  # an executor never yields a case twice; never record one twice
+                    continue
+                if bar is None:  # created after the pool has started its processes
+                    bar = tqdm(
+                        total=len(jobs),
+                        desc="sweep",
+                        unit="case",
+                        disable=not progress,
+                        file=sys.stderr,
+                        bar_format="{desc}: {n_fmt}/{total_fmt} cases done{postfix} |{bar}| "
+                        "[{elapsed}<{remaining}]",
+                    )
+                    bar.set_postfix_str("0 failed", refresh=False)
+                write_case(out / "cases" / cid, by_id[cid], scenarios[cid], outcome, save_results)
+                recorded.add(cid)
+                failed += not outcome["ok"]
+                bar.set_postfix_str(f"{failed} failed", refresh=False)
+                bar.update(1)
+        except KeyboardInterrupt:
+            raise StudyInterrupted(skipped + len(recorded), len(cases)) from None
+        except OutputError as exc:  # a full disk: what is recorded is whole; the rest runs on a resume
+            raise OutputError(
+                f"{exc}; {skipped + len(recorded)} of {len(cases)} cases recorded: make room and rerun the "
+                "same command to resume"
+            ) from None
+        finally:
+            if bar is not None:
+                bar.close()
+            close = getattr(runner, "close", None)
+            if close:
+                close()
+            shutil.rmtree(running, ignore_errors=True)
 
-    rows, summary_cols = collect_rows(out, cases, keys)
-    columns = ["id", *keys, "status", *summary_cols, "error"]
-    csv_path = write_csv(out / "summary.csv", rows, columns)
-    plot_path = plot_study(
-        rows,
-        keys,
-        plot_value,
-        plot_key,
-        out / f"{plot_value}_vs_{plot_key}.png",
-        title=f"{study.scene if len(study.scene) < 40 else Path(study.scene).name}: {plot_value} "
-        f"against {plot_key}",
-    )
-    return StudyResult(out, keys, rows, len(jobs), skipped, csv_path, plot_path, plot_value)
+        rows, summary_cols = collect_rows(out, cases, keys)
+        columns = ["id", *keys, "status", *summary_cols, "error"]
+        csv_path = write_csv(out / "summary.csv", rows, columns)
+        plot_path = plot_study(
+            rows,
+            keys,
+            plot_value,
+            plot_key,
+            out / f"{plot_value}_vs_{plot_key}.png",
+            title=f"{study.scene if len(study.scene) < 40 else Path(study.scene).name}: {plot_value} "
+            f"against {plot_key}",
+        )
+        return StudyResult(out, keys, rows, len(jobs), skipped, csv_path, plot_path, plot_value)

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from gearbody.errors import CalibrationFailed
+from gearbody.errors import CalibrationFailed, OutputError
+from gearbody.folders import atomic_write, claim
 from gearbody.version import __version__
 
 from .calibration import (
@@ -137,6 +138,7 @@ def calibrate_scene(
     max_evaluations: int = MAX_EVALUATIONS,
     force: bool = False,
     progress: bool = True,
+    overwrite: bool = False,
 ) -> SceneCalibration:
     """Fit ``parameters`` (scenario keys with bounds) of ``scene`` (a name or TOML path) to ``targets``
     (features of its ``cases``: ``{name: [KEY=VALUE, ...]}``), every run with ``overrides``.
@@ -145,7 +147,12 @@ def calibrate_scene(
     then at most ``polish_evaluations`` of the least-squares polish, then the Jacobian (parameters + 1).
     Before anything runs: every key, bound and case is loaded as a scenario, every feature parsed and the
     signals it reads looked up in a probe run; more than ``max_evaluations`` are refused unless
-    ``force``. Raises SweepSpecError (bad input), CalibrationFailed (every evaluation failed, exit 1),
+    ``force``. ``out`` resumes the same calibration (its ``evaluations.jsonl`` replayed); ``overwrite``
+    replaces what it holds instead (its gearbody outputs removed first).
+
+    Raises SweepSpecError (bad input; ``out`` holds something else, or a record that is not this
+    calibration's), FolderInUse (another command writes in ``out``), CalibrationFailed (every evaluation
+    failed, exit 1), OutputError (a file cannot be written: a full disk; the evaluations recorded stay),
     ImportError (nevergrad or dask missing)."""
     from gearbody.analysis.features import FeatureError, parse_feature
     from gearbody.model import ScenarioError, load_scenario, parse_override
@@ -209,94 +216,107 @@ def calibrate_scene(
 
     features = {case: tuple(dict.fromkeys(t.feature for t in targets if t.case == case)) for case in used}
     out = Path(out)
-    cache = EvaluationCache(
-        out / "evaluations.jsonl",
-        fingerprint(
-            "gearbody-calibration/1",
-            sha,
-            list(overrides),
-            {c: list(v) for c, v in used.items()},
-            {c: list(f) for c, f in features.items()},
-            keys,
-        ),
+    identity = fingerprint(
+        "gearbody-calibration/1",
+        sha,
+        list(overrides),
+        {c: list(v) for c, v in used.items()},
+        {c: list(f) for c, f in features.items()},
+        keys,
     )
-    stats = {"simulations": 0, "failed": 0, "cause": ""}
-    bar: dict[str, Any] = {"bar": None}  # created at the first evaluation (after the pool has started)
-
-    def evaluate(points: list[dict[str, float]]) -> list[dict[str, float] | None]:
-        jobs = []
-        for i, point in enumerate(points):
-            values = [[point[k] for k in keys]]
-            for c, extra in used.items():
-                args = (
-                    scene_features,
-                    [i],
-                    values,
-                    tuple(keys),
-                    features[c],
-                    (base, (*overrides, *extra), features[c]),
-                )
-                jobs.append((f"{i}@{c}", args))
-        results: list[dict[str, float] | None] = [{} for _ in points]
-        runner = run_jobs(
-            evaluate_rows, jobs, workers=workers, scheduler=scheduler, name="gearbody-calibrate"
-        )
+    with claim(out, "calibrate", overwrite=overwrite) as folder:  # locked while it writes
+        folder.begin()
         try:
-            for jid, outcome in runner:
-                i, _, c = jid.partition("@")
-                stats["simulations"] += 1
-                row = (outcome.get("rows") or [outcome])[0]
-                if not row.get("ok") or results[int(i)] is None:
-                    if not row.get("ok"):
-                        stats["cause"] = f"{row.get('error_type')}: {row.get('message', '')}"[:300]
-                    results[int(i)] = None
-                    continue
-                suffix = f"@{c}" if c else ""
-                results[int(i)].update({f"{f}{suffix}": v for f, v in row["values"].items()})
-        finally:
-            close = getattr(runner, "close", None)
-            if close:
-                close()
-        stats["failed"] += sum(r is None for r in results)
-        if bar["bar"] is None:
-            from tqdm import tqdm
+            cache = EvaluationCache(out / "evaluations.jsonl", identity)
+        except CalibrationError as exc:
+            resume = "rerun with the same arguments to resume, " if "another calibration" in str(exc) else ""
+            raise SweepSpecError(
+                f"--out {out} holds a record that is not this calibration's: {exc}; {resume}give --overwrite "
+                "to replace it, or choose another --out"
+            ) from None
+        stats = {"simulations": 0, "failed": 0, "cause": ""}
+        bar: dict[str, Any] = {"bar": None}  # created at the first evaluation (after the pool has started)
 
-            bar["bar"] = tqdm(
-                total=total, desc="calibrate", unit="eval", disable=not progress, file=sys.stderr
+        def evaluate(points: list[dict[str, float]]) -> list[dict[str, float] | None]:
+            jobs = []
+            for i, point in enumerate(points):
+                values = [[point[k] for k in keys]]
+                for c, extra in used.items():
+                    args = (
+                        scene_features,
+                        [i],
+                        values,
+                        tuple(keys),
+                        features[c],
+                        (base, (*overrides, *extra), features[c]),
+                    )
+                    jobs.append((f"{i}@{c}", args))
+            results: list[dict[str, float] | None] = [{} for _ in points]
+            runner = run_jobs(
+                evaluate_rows, jobs, workers=workers, scheduler=scheduler, name="gearbody-calibrate"
             )
-        bar["bar"].update(len(points))
-        bar["bar"].set_postfix_str(f"{stats['failed']} failed", refresh=False)
-        return results
+            try:
+                for jid, outcome in runner:
+                    i, _, c = jid.partition("@")
+                    stats["simulations"] += 1
+                    row = (outcome.get("rows") or [outcome])[0]
+                    if not row.get("ok") or results[int(i)] is None:
+                        if not row.get("ok"):
+                            stats["cause"] = f"{row.get('error_type')}: {row.get('message', '')}"[:300]
+                        results[int(i)] = None
+                        continue
+                    suffix = f"@{c}" if c else ""
+                    results[int(i)].update({f"{f}{suffix}": v for f, v in row["values"].items()})
+            finally:
+                close = getattr(runner, "close", None)
+                if close:
+                    close()
+            stats["failed"] += sum(r is None for r in results)
+            if bar["bar"] is None:
+                from tqdm import tqdm
 
-    if progress and cache.values:
-        print(f"resuming {out}: {len(cache.values)} evaluations recorded", file=sys.stderr)
-    try:
-        fit = calibrate(
-            evaluate,
-            parameters,
-            targets,
-            budget=budget,
-            batch=batch,
-            polish=polish,
-            polish_evaluations=polish_evaluations,
-            seed=seed,
-            cache=cache,
-        )
-    except KeyboardInterrupt:
-        raise KeyboardInterrupt(
-            f"interrupted: {len(cache.values)} evaluations recorded in {cache.path}; rerun the same command "
-            "to resume"
-        ) from None
-    finally:
-        if bar["bar"] is not None:
-            bar["bar"].close()
-    if not any(math.isfinite(v) for v in fit.features.values()):
-        raise CalibrationFailed(
-            f"{out}: every evaluation failed (last cause: {stats['cause'] or 'unknown'}); see {cache.path}"
-        )
-    wall = time.perf_counter() - t0
-    scenario_file = _write_outputs(out, fit, label, base, overrides, used, stats, wall)
-    return SceneCalibration(fit, out, stats["simulations"], stats["failed"], wall, scenario_file)
+                bar["bar"] = tqdm(
+                    total=total, desc="calibrate", unit="eval", disable=not progress, file=sys.stderr
+                )
+            bar["bar"].update(len(points))
+            bar["bar"].set_postfix_str(f"{stats['failed']} failed", refresh=False)
+            return results
+
+        if progress and cache.values:
+            print(f"resuming {out}: {len(cache.values)} evaluations recorded", file=sys.stderr)
+        try:
+            fit = calibrate(
+                evaluate,
+                parameters,
+                targets,
+                budget=budget,
+                batch=batch,
+                polish=polish,
+                polish_evaluations=polish_evaluations,
+                seed=seed,
+                cache=cache,
+            )
+        except OutputError as exc:  # a full disk: the record holds whole evaluations only
+            raise OutputError(
+                f"{exc}; the evaluations recorded in {cache.path} stay: make room and rerun the same "
+                "command to resume"
+            ) from None
+        except KeyboardInterrupt:
+            raise KeyboardInterrupt(
+                f"interrupted: {len(cache.values)} evaluations recorded in {cache.path}; rerun the same "
+                "command to resume"
+            ) from None
+        finally:
+            if bar["bar"] is not None:
+                bar["bar"].close()
+        if not any(math.isfinite(v) for v in fit.features.values()):
+            raise CalibrationFailed(
+                f"{out}: every evaluation failed (last cause: {stats['cause'] or 'unknown'}); see "
+                f"{cache.path}"
+            )
+        wall = time.perf_counter() - t0
+        scenario_file = _write_outputs(out, fit, label, base, overrides, used, stats, wall)
+        return SceneCalibration(fit, out, stats["simulations"], stats["failed"], wall, scenario_file)
 
 
 def _write_outputs(
@@ -314,7 +334,7 @@ def _write_outputs(
         + f" (files in {out})",
     )
     sc = sc.replace(meta=sc.meta.replace(name=f"{sc.meta.name}-calibrated", sources=sources))
-    scenario_file = dump_scenario(sc, out / "calibrated.toml")
+    scenario_file = atomic_write(out / "calibrated.toml", lambda p: dump_scenario(sc, p))
     write_json(
         out / "calibration.json",
         {

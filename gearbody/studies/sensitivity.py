@@ -39,7 +39,8 @@ from typing import Any
 
 import numpy as np
 
-from gearbody.errors import StudyError
+from gearbody.errors import OutputError, StudyError
+from gearbody.folders import claim, output_error
 from gearbody.version import __version__
 
 from .executors import check_options, failure, run_jobs
@@ -200,33 +201,32 @@ def ishigami(values: Mapping[str, float], a: float = 7.0, b: float = 0.1) -> dic
 
 
 # -- the record in OUT ---------------------------------------------------------------------------------
+_ADVICE = "give --overwrite to replace it, or choose another --out"
+
+
 def _prepare_out(out: Path, spec: dict[str, Any], X: np.ndarray) -> None:
     """Create OUT/sensitivity.json, or check that the one there is this analysis (spec and sample)."""
     path = out / "sensitivity.json"
     if path.exists():
         old = read_json(path)
         if old is None or old.get("format") != FORMAT:
-            raise SweepSpecError(
-                f"--out {out}: {path} is not a gearbody sensitivity file; choose another --out"
-            )
+            raise SweepSpecError(f"--out {out}: {path} is not a gearbody sensitivity file; {_ADVICE}")
         old_spec = old.get("spec", {})
         diff = [k for k in sorted(set(spec) | set(old_spec)) if old_spec.get(k) != spec.get(k)]
         if diff:
             shown = "; ".join(f"{k}: {old_spec.get(k)!r} there, {spec.get(k)!r} now" for k in diff)
             raise SweepSpecError(
                 f"--out {out} holds a different sensitivity analysis ({shown}); rerun with the same "
-                "arguments to resume, or choose another --out"
+                f"arguments to resume, {_ADVICE}"
             )
         if not np.array_equal(np.asarray(old.get("sample", []), dtype=float), X):
             raise SweepSpecError(
                 f"--out {out}: same arguments but a different sample matrix (another SALib or numpy "
-                "version?); choose another --out"
+                f"version?); {_ADVICE}"
             )
         return
     if (out / "evaluations").exists():
-        raise SweepSpecError(
-            f"--out {out} has an evaluations/ folder but no sensitivity.json; choose another --out"
-        )
+        raise SweepSpecError(f"--out {out} has an evaluations/ folder but no sensitivity.json; {_ADVICE}")
     out.mkdir(parents=True, exist_ok=True)
     write_json(
         path,
@@ -379,6 +379,7 @@ def analyse_model(
     progress: bool = True,
     title: str = "",
     check: Callable[[np.ndarray], None] | None = None,
+    overwrite: bool = False,
 ) -> SensitivityResult:
     """Sensitivity indices of ``model``'s ``outputs`` to ``keys`` over their ranges, resuming whatever
     ``out`` holds of the same analysis.
@@ -401,8 +402,12 @@ def analyse_model(
         exclude_failed: Morris only: drop the trajectories holding failed rows instead of refusing.
         title: of the plot.
         check: called with the sample matrix before anything runs or is written (raises on a bad row).
+        overwrite: replace what ``out`` holds (its gearbody outputs removed first) instead of resuming.
     Raises:
-        SweepSpecError: bad input (before anything runs), or ``out`` holds another analysis.
+        SweepSpecError: bad input (before anything runs), or ``out`` holds something else than this
+            analysis (see ``overwrite``).
+        FolderInUse: another command is writing in ``out`` (its lock, :mod:`gearbody.folders`).
+        OutputError: a file could not be written (a full disk); the rows written stay recorded.
         MissingRowsError: rows failed (all recorded); names them.
         ImportError: SALib (or dask.distributed for a scheduler) missing.
     """
@@ -459,56 +464,66 @@ def analyse_model(
     if check is not None:
         check(X)
     out = Path(out)
-    _prepare_out(out, spec, X)
-    (out / "evaluations").mkdir(exist_ok=True)
+    with claim(out, "sensitivity", overwrite=overwrite) as folder:  # locked while it writes
+        folder.begin()
+        _prepare_out(out, spec, X)
+        try:
+            (out / "evaluations").mkdir(exist_ok=True)
+        except OSError as exc:
+            raise output_error(out / "evaluations", exc) from None
 
-    recorded = _recorded(out)
-    pending = [r for r in range(n_rows) if r not in recorded or (retry_failed and not recorded[r].get("ok"))]
-    skipped = n_rows - len(pending)
-    if progress and skipped:
-        print(f"resuming {out}: {skipped} of {n_rows} rows already recorded", file=sys.stderr)
-    chunks = [pending[i : i + batch] for i in range(0, len(pending), batch)]
-    by_id = {_job_id(c): c for c in chunks}
-    keys_t, Xl = tuple(problem), X.tolist()
-    jobs = [
-        (jid, (model, c, [Xl[r] for r in c], keys_t, outputs, tuple(model_args))) for jid, c in by_id.items()
-    ]
-    _run(jobs, by_id, out, workers, scheduler, progress)
+        recorded = _recorded(out)
+        pending = [
+            r for r in range(n_rows) if r not in recorded or (retry_failed and not recorded[r].get("ok"))
+        ]
+        skipped = n_rows - len(pending)
+        if progress and skipped:
+            print(f"resuming {out}: {skipped} of {n_rows} rows already recorded", file=sys.stderr)
+        chunks = [pending[i : i + batch] for i in range(0, len(pending), batch)]
+        by_id = {_job_id(c): c for c in chunks}
+        keys_t, Xl = tuple(problem), X.tolist()
+        jobs = [
+            (jid, (model, c, [Xl[r] for r in c], keys_t, outputs, tuple(model_args)))
+            for jid, c in by_id.items()
+        ]
+        _run(jobs, by_id, out, workers, scheduler, progress)
 
-    recorded = _recorded(out)
-    failed = [r for r in range(n_rows) if not recorded.get(r, {}).get("ok")]
-    failed_set = set(failed)
-    keep = None
-    if failed:
-        causes = "; ".join(
-            f"row {r}: {recorded[r].get('error_type')}: {recorded[r].get('message', '')}".strip()[:300]
-            for r in failed[:3]
-            if r in recorded
+        recorded = _recorded(out)
+        failed = [r for r in range(n_rows) if not recorded.get(r, {}).get("ok")]
+        failed_set = set(failed)
+        keep = None
+        if failed:
+            causes = "; ".join(
+                f"row {r}: {recorded[r].get('error_type')}: {recorded[r].get('message', '')}".strip()[:300]
+                for r in failed[:3]
+                if r in recorded
+            )
+            if not exclude_failed:
+                hint = " or (Morris only) exclude_failed / --exclude-failed" if method == "morris" else ""
+                raise MissingRowsError(
+                    f"{out}: no indices: {len(failed)} of {n_rows} rows failed or missing (rows "
+                    f"{_rows_text(failed)}; {causes}); every evaluation is in {out / 'evaluations'}; fix "
+                    f"the cause and rerun with retry_failed / --retry-failed{hint}"
+                )
+            size = len(problem) + 1
+            bad = {r // size for r in failed}
+            keep = np.array([r // size not in bad for r in range(n_rows)])
+            if (n_rows // size) - len(bad) < 2:
+                raise MissingRowsError(
+                    f"{out}: fewer than 2 Morris trajectories without failed rows "
+                    f"(rows {_rows_text(failed)}; {causes})"
+                )
+        values = {
+            o: np.array([recorded[r]["values"][o] if r not in failed_set else np.nan for r in range(n_rows)])
+            for o in outputs
+        }
+        indices = {o: _analyse(spec, X, values[o], keep) for o in outputs}
+        excluded = tuple(int(r) for r in range(n_rows) if keep is not None and not keep[r])
+        res = SensitivityResult(
+            out, method, keys_t, outputs, indices, n_rows, len(pending), skipped, excluded
         )
-        if not exclude_failed:
-            hint = " or (Morris only) exclude_failed / --exclude-failed" if method == "morris" else ""
-            raise MissingRowsError(
-                f"{out}: no indices: {len(failed)} of {n_rows} rows failed or missing (rows "
-                f"{_rows_text(failed)}; {causes}); every evaluation is in {out / 'evaluations'}; fix the "
-                f"cause and rerun with retry_failed / --retry-failed{hint}"
-            )
-        size = len(problem) + 1
-        bad = {r // size for r in failed}
-        keep = np.array([r // size not in bad for r in range(n_rows)])
-        if (n_rows // size) - len(bad) < 2:
-            raise MissingRowsError(
-                f"{out}: fewer than 2 Morris trajectories without failed rows "
-                f"(rows {_rows_text(failed)}; {causes})"
-            )
-    values = {
-        o: np.array([recorded[r]["values"][o] if r not in failed_set else np.nan for r in range(n_rows)])
-        for o in outputs
-    }
-    indices = {o: _analyse(spec, X, values[o], keep) for o in outputs}
-    excluded = tuple(int(r) for r in range(n_rows) if keep is not None and not keep[r])
-    res = SensitivityResult(out, method, keys_t, outputs, indices, n_rows, len(pending), skipped, excluded)
-    _write_outputs(res, title or f"{method} sensitivity indices")
-    return res
+        _write_outputs(res, title or f"{method} sensitivity indices")
+        return res
 
 
 def _run(jobs, by_id, out: Path, workers, scheduler, progress: bool) -> None:
@@ -519,7 +534,7 @@ def _run(jobs, by_id, out: Path, workers, scheduler, progress: bool) -> None:
 
     runner = run_jobs(evaluate_rows, jobs, workers=workers, scheduler=scheduler, name="gearbody-sensitivity")
     total = sum(len(c) for c in by_id.values())
-    bar, failed = None, 0
+    bar, failed, written = None, 0, 0
     try:
         for jid, outcome in runner:
             if bar is None:  # created after the pool has started its processes
@@ -527,9 +542,15 @@ def _run(jobs, by_id, out: Path, workers, scheduler, progress: bool) -> None:
             if outcome.get("rows") is None:  # the worker died: every row of the job failed with its cause
                 outcome = {"rows": [{"row": r, **outcome} for r in by_id[jid]]}
             write_json(out / "evaluations" / f"{jid}.json", {"job": jid, "rows": outcome["rows"]})
+            written += len(outcome["rows"])
             failed += sum(not e.get("ok") for e in outcome["rows"])
             bar.set_postfix_str(f"{failed} failed", refresh=False)
             bar.update(len(outcome["rows"]))
+    except OutputError as exc:  # a full disk: what is recorded is whole; the rest runs on a resume
+        raise OutputError(
+            f"{exc}; {written} of the {total} runs of this call recorded: make room and rerun the same "
+            "command to resume"
+        ) from None
     finally:
         if bar is not None:
             bar.close()

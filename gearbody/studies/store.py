@@ -6,15 +6,13 @@ failed case. A case is done when its ``summary.json`` (or ``error.json``) is the
 from __future__ import annotations
 
 import json
-import os
 import time
-import uuid
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from gearbody.folders import atomic_write, output_error, write_text
 from gearbody.model import Scenario, dump_scenario
 from gearbody.version import __version__
 
@@ -33,22 +31,6 @@ __all__ = [
 ]
 
 STUDY_FORMAT = "gearbody-sweep/1"
-
-
-def atomic_write(path: Path, write: Callable[[Path], Any]) -> Path:
-    """Write via a temporary file in the same folder and ``os.replace``: readers never see a part."""
-    tmp = path.with_name(f".{path.stem}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp{path.suffix}")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    return path
-
-
-def write_text(path: Path, text: str) -> Path:
-    return atomic_write(path, lambda p: p.write_text(text))
 
 
 def write_json(path: Path, data: Any) -> Path:
@@ -72,9 +54,14 @@ def read_json(path: Path) -> dict | None:
 
 
 def write_case(case_dir: Path, case: Case, scenario: Scenario, outcome: dict, save_results: bool) -> None:
-    """A finished case's files; ``summary.json`` (or ``error.json``) last: it marks the case done."""
-    case_dir.mkdir(parents=True, exist_ok=True)
-    for stale in case_dir.glob(".*.tmp*"):  # left by an interrupted run
+    """A finished case's files; ``summary.json`` (or ``error.json``) last: it marks the case done. A file
+    that cannot be written (a full disk) raises :class:`~gearbody.errors.OutputError` naming it, and
+    the case stays pending: a resume runs it again."""
+    try:
+        case_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise output_error(case_dir, exc) from None
+    for stale in case_dir.glob(".*.tmp*"):  # left by an interrupted run (the folder is locked: not live)
         stale.unlink(missing_ok=True)
     head = {"case": case.id, "values": case.texts, "overrides": list(case.overrides)}
     if outcome["ok"]:
@@ -100,29 +87,31 @@ def case_state(case_dir: Path) -> tuple[str, dict | None]:
 
 
 def prepare_out(out: Path, study: Study, cases: list[Case]) -> None:
-    """Create OUT/study.json, or check that the one there describes this study."""
+    """Create OUT/study.json, or check that the one there describes this study (call it on a claimed
+    folder, :func:`gearbody.folders.claim`)."""
     path = out / "study.json"
     spec = study.spec()
     listing = [{"id": c.id, "overrides": list(c.overrides)} for c in cases]
+    advice = "give --overwrite to replace it, or choose another --out"
     if path.exists():
         old = read_json(path)
         if old is None or old.get("format") != STUDY_FORMAT:
-            raise SweepSpecError(f"--out {out}: {path} is not a gearbody study file; choose another --out")
+            raise SweepSpecError(f"--out {out}: {path} is not a gearbody study file; {advice}")
         diff = [k for k in spec if old.get("spec", {}).get(k) != spec[k]]
         if diff:
             shown = "; ".join(f"{k}: {old.get('spec', {}).get(k)!r} there, {spec[k]!r} now" for k in diff)
             raise SweepSpecError(
                 f"--out {out} holds a different study ({shown}); rerun with the same arguments to resume, "
-                "or choose another --out"
+                f"{advice}"
             )
         if old.get("cases") != listing:
             raise SweepSpecError(
                 f"--out {out}: same arguments but different cases (random draws changed with this numpy?); "
-                "choose another --out"
+                f"{advice}"
             )
         return
     if (out / "cases").exists():
-        raise SweepSpecError(f"--out {out} has a cases/ folder but no study.json; choose another --out")
+        raise SweepSpecError(f"--out {out} has a cases/ folder but no study.json; {advice}")
     out.mkdir(parents=True, exist_ok=True)
     write_json(
         path,
