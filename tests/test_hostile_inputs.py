@@ -25,3 +25,159 @@ def test_counts_that_size_arrays_are_bounded(tmp_path, capsys, scene, sets, key)
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and key in err[0]
     assert not (tmp_path / "run").exists()
+
+
+# -- scenario files: only regular files, at most 1 MiB, nesting bounded -----------------------------------
+
+
+def _one_line_refusal(capsys, argv: list[str], expected: str) -> str:
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and expected in err[0], err
+    return err[0]
+
+
+def _main_reading_fifo(fifo, argv: list[str]) -> int:
+    """``main(argv)`` in a thread; when it is still blocked on ``fifo`` after 20 s, a writer end opened and
+    closed releases it and the test fails (on main the FIFO blocked forever)."""
+    import os
+    import threading
+
+    outcome: list[int] = []
+    worker = threading.Thread(target=lambda: outcome.append(main(argv)), daemon=True)
+    worker.start()
+    worker.join(20.0)
+    if worker.is_alive():
+        with open(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK), "wb"):
+            pass
+        worker.join(30.0)
+        pytest.fail(f"gearbody {argv[0]} blocked on the FIFO {fifo}")
+    return outcome[0]
+
+
+def test_a_fifo_as_the_scenario_file_is_refused_not_waited_on(tmp_path, capsys):
+    """On main ``gearbody run FIFO`` blocked forever in open(): nothing writes the FIFO."""
+    import os
+
+    fifo = tmp_path / "drive.toml"
+    os.mkfifo(fifo)
+    assert _main_reading_fifo(fifo, ["run", str(fifo), "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"{fifo}: a FIFO (named pipe), not a scenario file" in err[0]
+    assert not (tmp_path / "r").exists()
+
+
+@pytest.mark.parametrize("device", ["/dev/zero", "/dev/null"])
+def test_a_device_as_the_scenario_file_is_refused_before_it_is_read(tmp_path, capsys, device):
+    """On main ``gearbody run /dev/zero`` read until MemoryError."""
+    import os
+
+    if not os.path.exists(device):
+        pytest.skip(f"no {device} here")
+    _one_line_refusal(
+        capsys, ["run", device, "--out", str(tmp_path / "r")], f"{device}: a character device, not a scenario"
+    )
+
+
+def test_a_scenario_file_above_one_mebibyte_is_refused_naming_its_size(tmp_path, capsys):
+    from gearbody.model.io import MAX_SCENARIO_BYTES
+
+    big = tmp_path / "big.toml"
+    big.write_text("# padding\n" * (MAX_SCENARIO_BYTES // 10 + 1))  # valid TOML: comments only
+    size = big.stat().st_size
+    assert size > MAX_SCENARIO_BYTES
+    _one_line_refusal(
+        capsys,
+        ["run", str(big), "--out", str(tmp_path / "r")],
+        f"{big}: too large for a scenario file ({size} bytes); allowed: at most 1048576 bytes",
+    )
+
+
+def test_a_profile_of_25000_points_is_within_the_size_limit(tmp_path):
+    """The limit's reason: a measured load profile of 25,000 points still fits (docstring of the limit)."""
+    import numpy as np
+
+    from gearbody.model import load_scenario
+    from gearbody.model.io import MAX_SCENARIO_BYTES
+    from gearbody.model.scenes import scene_path
+
+    rng = np.random.default_rng(0)
+    times = np.concatenate([[0.0], np.sort(rng.uniform(0.001, 2.0, 24_999))])
+    fractions = rng.uniform(0.0, 1.0, times.size)
+    lines = scene_path("one-stage").read_text().splitlines()
+    given = [k for k, line in enumerate(lines) if line.startswith("load_profile = ")]
+    assert len(given) == 1
+    lines[given[0]] = (
+        "load_profile = { time_s = ["
+        + ", ".join(repr(float(t)) for t in times)
+        + "], fraction = ["
+        + ", ".join(repr(float(f)) for f in fractions)
+        + "] }"
+    )
+    path = tmp_path / "measured.toml"
+    path.write_text("\n".join(lines) + "\n")
+    assert path.stat().st_size <= MAX_SCENARIO_BYTES
+    assert len(load_scenario(path).operation.load_profile.time_s) == 25_000
+
+
+@pytest.mark.parametrize(
+    ("text", "what"),
+    [
+        ("a = " + "[" * 600 + "]" * 600 + "\n", "an array nested 600 deep"),  # RecursionError on main
+        ("x = " + "{a=" * 600 + "1" + "}" * 600 + "\n", "inline tables nested 600 deep"),
+        ("[" + ".".join(["a"] * 900) + "]\n", "a 900-part table header"),  # RecursionError on main
+        ("a = " + "[" * 33 + "]" * 33 + "\n", "an array nested 33 deep"),
+    ],
+)
+def test_a_scenario_file_nested_too_deep_is_refused_in_one_line(tmp_path, capsys, text, what):
+    path = tmp_path / "deep.toml"
+    path.write_text(text)
+    _one_line_refusal(
+        capsys,
+        ["run", str(path), "--out", str(tmp_path / "r")],
+        f"{path}: tables and arrays nested more than 32 levels deep; allowed: at most 32",
+    )
+
+
+@pytest.mark.parametrize(
+    "override",
+    [
+        "a=" + "[" * 600 + "]" * 600,  # RecursionError on main
+        "a=" + "{b=" * 600 + "1" + "}" * 600,
+        "condition." + ".".join(["a"] * 900) + "=1",
+        "operation.speed_profile.time_s=" + "[" * 30 + "0" + "]" * 30,
+    ],
+)
+def test_a_set_nested_too_deep_is_refused_in_one_line(tmp_path, capsys, override):
+    line = _one_line_refusal(
+        capsys,
+        ["run", "one-stage", "--out", str(tmp_path / "r"), "--set", override],
+        "nest",
+    )
+    assert "--set " in line and "more than 32 levels deep" in line and "allowed: at most 32" in line
+
+
+def test_every_scene_nests_within_the_limit():
+    from gearbody.model import load_scenario
+    from gearbody.model.io import MAX_NESTING, nesting_depth, read_toml, scenario_to_dict
+    from gearbody.model.scenes import list_scenes, scene_path
+
+    for name in list_scenes():
+        assert nesting_depth(read_toml(scene_path(name))) <= 7 < MAX_NESTING
+        assert nesting_depth(scenario_to_dict(load_scenario(name))) <= 7
+
+
+def test_studies_refuse_a_fifo_as_the_scene_too(tmp_path, capsys):
+    import os
+
+    fifo = tmp_path / "drive.toml"
+    os.mkfifo(fifo)
+    expected = f"{fifo}: a FIFO (named pipe), not a scenario file"
+    for argv in (
+        ["sweep", str(fifo), "--vary", "production.error_mode.e_um=0,5", "--out", str(tmp_path / "s")],
+        ["sensitivity", str(fifo), "--key", "design.mesh.damping_Ns_per_m=3000:12000"]
+        + ["--feature", "kd_max", "--out", str(tmp_path / "e")],
+    ):
+        assert _main_reading_fifo(fifo, argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and expected in err[0], err

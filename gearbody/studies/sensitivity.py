@@ -559,20 +559,19 @@ def scene_features(
 
 def read_scene(scene: str | Path) -> tuple[str, dict[str, Any], str]:
     """(label stored in the spec, TOML data, sha256 of the file) of a scene name or TOML path."""
-    from gearbody.model import ScenarioError, scene_path
-    from gearbody.model.io import read_toml
+    from gearbody.model import scene_path
+    from gearbody.model.io import parse_scenario_bytes, read_scenario_bytes
 
     path = Path(scene)
     if not path.suffix and not path.exists():
         label, path = str(scene), scene_path(str(scene))
-    elif not path.is_file():
-        raise ScenarioError(f"{path}: no such scenario file")
     else:
         label = str(path.resolve())
-    base = read_toml(path)
+    data = read_scenario_bytes(path)  # refuses a missing file, a folder, a FIFO, a device, a huge file
+    base = parse_scenario_bytes(data, path)
     if isinstance(base.get("meta"), dict):
         base["meta"].setdefault("name", path.stem)
-    return label, base, hashlib.sha256(path.read_bytes()).hexdigest()
+    return label, base, hashlib.sha256(data).hexdigest()
 
 
 def sensitivity(
