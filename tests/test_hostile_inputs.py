@@ -181,3 +181,56 @@ def test_studies_refuse_a_fifo_as_the_scene_too(tmp_path, capsys):
         assert _main_reading_fifo(fifo, argv) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and expected in err[0], err
+
+
+# -- --scheduler: a Dask address, checked before anything runs -------------------------------------------
+
+STUDIES = {
+    "sweep": ["sweep", "one-stage", "--vary", "production.error_mode.e_um=0,5"],
+    "sensitivity": ["sensitivity", "one-stage", "--key", "design.mesh.damping_Ns_per_m=3000:12000"]
+    + ["--feature", "kd_max", "--samples", "2"],
+    "calibrate": ["calibrate", "one-stage", "--param", "design.mesh.damping_Ns_per_m=3000:12000"]
+    + ["--target", "kd_max", "1.2", "0.1"],
+}
+
+
+@pytest.mark.parametrize("command", list(STUDIES))
+@pytest.mark.parametrize(
+    ("address", "reason"),
+    [
+        ("not a url", "not a Dask scheduler address"),  # Dask's ValueError as a traceback on main
+        ("", "not a Dask scheduler address"),
+        ("http://127.0.0.1:1", "the scheme http:// is not one a study reaches a Dask scheduler by"),
+        ("tcp://127.0.0.1:70000", "port 70000 does not exist"),
+        ("tcp://127.0.0.1", "not a Dask scheduler address"),
+    ],
+)
+def test_a_malformed_scheduler_is_refused_in_one_line_before_anything_runs(
+    tmp_path, capsys, command, address, reason
+):
+    out = tmp_path / "study"
+    argv = [*STUDIES[command], "--t-end", "0.003", "--scheduler", address, "--out", str(out)]
+    line = _one_line_refusal(capsys, argv, f"--scheduler = {address!r}: {reason}")
+    assert "allowed: SCHEME://HOST:PORT" in line and "tcp://head:8786" in line
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "address", ["tcp://head:8786", "head:8786", "tls://10.0.0.1:8786", "ws://[::1]:8786"]
+)
+def test_the_scheduler_addresses_dask_serves_pass_the_check(address):
+    from gearbody.studies.executors import check_scheduler_address
+
+    check_scheduler_address(address)
+
+
+def test_a_scheduler_that_does_not_answer_fails_in_one_line_after_the_timeout(tmp_path, capsys, monkeypatch):
+    """A well-formed address with no scheduler behind it (only 127.0.0.1 is contacted): exit 2, one line
+    naming the address and the timeout."""
+    pytest.importorskip("dask.distributed")
+    from gearbody.studies import executors
+
+    monkeypatch.setattr(executors, "CONNECT_TIMEOUT_S", 2.0)
+    argv = [*STUDIES["sweep"], "--t-end", "0.003", "--scheduler", "tcp://127.0.0.1:1", "--out", str(tmp_path)]
+    line = _one_line_refusal(capsys, argv, "--scheduler tcp://127.0.0.1:1: cannot connect: ")
+    assert "after 2 s" in line
