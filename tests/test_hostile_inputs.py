@@ -234,3 +234,46 @@ def test_a_scheduler_that_does_not_answer_fails_in_one_line_after_the_timeout(tm
     argv = [*STUDIES["sweep"], "--t-end", "0.003", "--scheduler", "tcp://127.0.0.1:1", "--out", str(tmp_path)]
     line = _one_line_refusal(capsys, argv, "--scheduler tcp://127.0.0.1:1: cannot connect: ")
     assert "after 2 s" in line
+
+
+# -- run: a run too short for what it writes is refused before it runs ----------------------------------
+
+
+@pytest.mark.parametrize(
+    ("extra", "named"),
+    [
+        (["--t-end", "1e-4"], "--t-end = 0.0001: 3 output samples"),  # the spectrum plot raised on main
+        (["--set", "operation.t_end_s=1e-4"], "operation.t_end_s = 0.0001: 3 output samples"),
+        (["--t-end", "1e-4", "--no-plots", "--report"], "--t-end = 0.0001: 3 output samples"),
+    ],
+)
+def test_a_run_too_short_for_its_plots_is_refused_before_it_runs(tmp_path, capsys, extra, named):
+    from gearbody.plotting.run import MIN_PLOT_SAMPLES
+
+    out = tmp_path / "run"
+    line = _one_line_refusal(capsys, ["run", "one-stage", *extra, "--out", str(out)], named)
+    option = named.split(" = ")[0]
+    assert (
+        f"need at least {MIN_PLOT_SAMPLES}; allowed: {option} >= {(MIN_PLOT_SAMPLES - 1) / 20000:g}" in line
+    )
+    assert "--no-plots" in line
+    assert not out.exists()
+
+
+def test_a_short_run_without_plots_still_writes_its_result(tmp_path):
+    out = tmp_path / "run"
+    assert main(["run", "one-stage", "--t-end", "1e-4", "--no-plots", "--quiet", "--out", str(out)]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["result.npz", "scenario.toml", "summary.json"]
+
+
+@pytest.mark.parametrize("scene", ["one-stage", "lateral-8dof-ball", "planetary-conveyor"])
+def test_at_the_fewest_samples_accepted_every_plot_and_the_report_are_drawn(tmp_path, scene):
+    from gearbody.plotting.run import MIN_PLOT_SAMPLES
+
+    t_end = (MIN_PLOT_SAMPLES - 1) / 20000  # the scenes' output rate
+    out = tmp_path / "run"
+    argv = ["run", scene, "--t-end", repr(t_end), "--report", "--quiet", "--out", str(out)]
+    assert main(argv) == 0
+    assert (out / "report.html").is_file() and len(list(out.glob("*.png"))) >= 3
+    shorter = ["run", scene, "--t-end", repr(t_end - 1 / 20000), "--quiet", "--out", str(tmp_path / "no")]
+    assert main(shorter) == 2
