@@ -277,3 +277,45 @@ def test_at_the_fewest_samples_accepted_every_plot_and_the_report_are_drawn(tmp_
     assert (out / "report.html").is_file() and len(list(out.glob("*.png"))) >= 3
     shorter = ["run", scene, "--t-end", repr(t_end - 1 / 20000), "--quiet", "--out", str(tmp_path / "no")]
     assert main(shorter) == 2
+
+
+# -- render --result: a result holding NaN is refused naming the signal ----------------------------------
+
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("short") / "run"
+    assert main(["run", "one-stage", "--t-end", "0.005", "--no-plots", "--quiet", "--out", str(out)]) == 0
+    return out
+
+
+@pytest.mark.parametrize(
+    ("spoil", "named"),
+    [
+        ("every", "time_s holds 101 of 101 values that are not finite"),  # an IndexError on main
+        ("pinion_angle_rad", "pinion_angle_rad holds 1 of 101 values that are not finite (NaN or inf, "),
+        ("wheel_angle_rad", "wheel_angle_rad holds 1 of 101 values that are not finite (NaN or inf, "),
+    ],
+)
+def test_render_of_a_result_holding_nan_is_refused_naming_the_signal(
+    short_run, tmp_path, capsys, spoil, named
+):
+    import numpy as np
+
+    arrays = dict(np.load(short_run / "result.npz"))
+    for name, values in arrays.items():
+        if values.dtype.kind == "f" and (spoil == "every" or name == spoil):
+            values = values.copy()
+            if spoil == "every":
+                values[:] = np.nan
+            else:
+                values[50] = np.nan  # one sample in the middle of the run
+            arrays[name] = values
+    spoiled = tmp_path / "spoiled.npz"
+    np.savez(spoiled, **arrays)
+    out = tmp_path / "render"
+    argv = ["render", "one-stage", "--result", str(spoiled), "--frames", "2", "--quiet", "--out", str(out)]
+    line = _one_line_refusal(capsys, argv, f"--result = {spoiled}: {named}")
+    if spoil != "every":
+        assert "the first at t = 0.0025 s" in line
+    assert not list(out.glob("frame_*.png"))

@@ -212,7 +212,10 @@ def execute(args) -> int:
             progress=not args.quiet,
         )
     except RenderError as exc:
-        return usage_error("render", str(exc))
+        message = str(exc)
+        if args.result is not None and message.startswith("result: "):  # name the file the user gave
+            message = f"--result = {args.result}: " + message.removeprefix("result: ")
+        return usage_error("render", message)
     if not args.quiet:
         per = out.render_s / max(len(out.frames), 1)
         print(
