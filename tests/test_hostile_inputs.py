@@ -319,3 +319,26 @@ def test_render_of_a_result_holding_nan_is_refused_naming_the_signal(
     if spoil != "every":
         assert "the first at t = 0.0025 s" in line
     assert not list(out.glob("frame_*.png"))
+
+
+# -- messages name the key the user wrote ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("sets", "named"),
+    [
+        (  # on main: "design.stages.1: planet_angles_rad[1] = 0.523599: planets 1 and 2 overlap"
+            ["design.stages.1.planet_angles_deg=[0,120,240]", "design.stages.1.planet_angles_deg.2=30"],
+            "design.stages.1.planet_angles_deg.2 = 30: planets 1 and 2 overlap",
+        ),
+        (  # planet 1 is the reference at 0: the overlap with it is planet 3's to fix
+            ["design.stages.1.planet_angles_deg=[0,120,338.1818181818182]"],
+            "design.stages.1.planet_angles_deg.3 = 338.182: planets 3 and 1 overlap",
+        ),
+        (["design.stages.1.planets=7"], "design.stages.1.planets = 7: equally spaced planets need"),
+    ],
+)
+def test_planet_angle_refusals_name_the_key_in_degrees_counted_from_one(tmp_path, capsys, sets, named):
+    args = [a for s in sets for a in ("--set", s)]
+    line = _one_line_refusal(capsys, ["run", "planetary", *args, "--out", str(tmp_path / "r")], named)
+    assert "planet_angles_rad" not in line
