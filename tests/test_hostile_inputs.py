@@ -342,3 +342,110 @@ def test_planet_angle_refusals_name_the_key_in_degrees_counted_from_one(tmp_path
     args = [a for s in sets for a in ("--set", s)]
     line = _one_line_refusal(capsys, ["run", "planetary", *args, "--out", str(tmp_path / "r")], named)
     assert "planet_angles_rad" not in line
+
+
+# -- bearings in the stiff-mode check --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("scene", "key", "value", "mass_key"),
+    [  # on main 1e20 had not finished 0.01 s simulated after 120 s, 1e14 took 25 s
+        (
+            "lateral-8dof",
+            "design.pinion.bearing.parameters.stiffness_x_N_per_m",
+            "1e20",
+            "pinion.mass_kg = 7.78",
+        ),
+        (
+            "lateral-8dof",
+            "design.pinion.bearing.parameters.stiffness_x_N_per_m",
+            "1e14",
+            "pinion.mass_kg = 7.78",
+        ),
+        (
+            "lateral-6dof",
+            "design.wheel.bearing.parameters.stiffness_y_N_per_m",
+            "1e20",
+            "wheel.mass_kg = 71.6",
+        ),
+        (  # a Hertzian law: its tangent stiffness where it carries the rated mesh force
+            "lateral-8dof-ball",
+            "design.pinion.bearing.parameters.contact_stiffness_N_per_m_n",
+            "1e20",
+            "pinion.mass_kg = 7.78",
+        ),
+    ],
+)
+def test_an_absurd_bearing_stiffness_is_refused_naming_it(scene, key, value, mass_key):
+    from gearbody.assembly import check_resolved_modes
+    from gearbody.errors import InputError
+    from gearbody.model import load_scenario
+
+    sc = load_scenario(scene, [f"{key}={value}", "operation.t_end_s=0.01"])
+    with pytest.raises(InputError) as info:
+        check_resolved_modes(sc)
+    msg = str(info.value)
+    canonical = key.replace("design.", "design.stages.1.", 1)
+    assert f"design.stages.1.{mass_key} kg: against its stiffness" in msg
+    assert f"mostly from {canonical}) this gives a natural frequency" in msg
+    assert "lower that stiffness" in msg
+
+
+def test_a_bearing_stiffness_enters_the_check_as_the_modes_see_it():
+    """sqrt(K_ii / M_ii) with the bearing is the Rayleigh quotient of the linearised model: it grows with
+    the bearing stiffness and stays below the highest natural frequency."""
+    from gearbody.assembly import coordinate_frequencies
+    from gearbody.engine.modes import scene_modes
+    from gearbody.model import load_scenario
+
+    key = "design.pinion.bearing.parameters.stiffness_x_N_per_m"
+    for k in (4e8, 4e10):
+        sc = load_scenario("lateral-8dof", [f"{key}={k:g}"])
+        pinion_x = next(c for c in coordinate_frequencies(sc) if c.name == "pinion_x")
+        assert pinion_x.stiffness == pytest.approx(k, rel=1e-9)  # no mesh stiffness along x
+        assert pinion_x.frequency_hz <= scene_modes(sc).frequencies_hz.max() * (1 + 1e-9)
+
+
+@pytest.mark.parametrize(
+    ("key", "named"),
+    [  # on main the planet bearing damping was blamed on "design.stages.1.sun_mesh / ring_mesh"
+        ("design.stages.1.planet.bearing_damping_Ns_per_m", "planet.mass_kg = 0.66 kg: against its damping"),
+        # on main left out: accepted and run
+        ("design.stages.1.sun.bearing_damping_Ns_per_m", "sun.mass_kg = 0.4 kg: against its damping"),
+        (
+            "design.stages.1.carrier.bearing_damping_Ns_per_m",
+            "carrier.mass_kg = 5.43 kg: against its damping",
+        ),
+    ],
+)
+def test_a_planetary_bearing_damping_is_blamed_on_its_own_key(key, named):
+    from gearbody.assembly import check_resolved_modes
+    from gearbody.errors import InputError
+    from gearbody.model import load_scenario
+
+    sc = load_scenario("planetary", [f"{key}=1e8"])
+    with pytest.raises(InputError) as info:
+        check_resolved_modes(sc)
+    msg = str(info.value)
+    assert f"design.stages.1.{named}" in msg and f"mostly from {key})" in msg
+
+
+def test_planetary_bearing_laws_stay_below_the_modes():
+    from gearbody.assembly import check_resolved_modes, coordinate_frequencies
+    from gearbody.engine.modes import scene_modes
+    from gearbody.model import load_scenario
+
+    law = (
+        "bearing={kind='hertzian',parameters={contact_stiffness_N_per_m_n=5e11,radial_clearance_m=1e-6,"
+        "exponent=1.5,damping_Ns_per_m=200.0}}"
+    )
+    members = {
+        "sun": "teeth=29,inertia_kg_m2=0.00061009,mass_kg=0.4",
+        "planet": "teeth=37,inertia_kg_m2=0.00155335,mass_kg=0.66",
+        "carrier": "inertia_kg_m2=0.0616483,mass_kg=5.43",
+    }
+    sc = load_scenario("planetary", [f"design.stages.1.{m}={{{v},{law}}}" for m, v in members.items()])
+    check_resolved_modes(sc)
+    freqs = {c.name: c for c in coordinate_frequencies(sc)}
+    assert freqs["planet_1_y"].stiffness_source == "design.stages.1.planet.bearing.parameters"
+    assert max(c.frequency_hz for c in freqs.values()) <= scene_modes(sc).frequencies_hz.max() * (1 + 1e-9)
