@@ -449,3 +449,61 @@ def test_planetary_bearing_laws_stay_below_the_modes():
     freqs = {c.name: c for c in coordinate_frequencies(sc)}
     assert freqs["planet_1_y"].stiffness_source == "design.stages.1.planet.bearing.parameters"
     assert max(c.frequency_hz for c in freqs.values()) <= scene_modes(sc).frequencies_hz.max() * (1 + 1e-9)
+
+
+# -- feature windows checked against the scenario before any run -----------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("argv", "named"),
+    [
+        (  # on main every run was simulated, then each failed with the FeatureError
+            ["sensitivity", "one-stage", "--key", "design.mesh.damping_Ns_per_m=3000:12000"]
+            + ["--feature", "kd_max:period=99", "--samples", "2", "--t-end", "0.005"],
+            "--feature kd_max:period=99: period = 99: the record has periods 1..1 in a run of "
+            "operation.t_end_s = 0.005 s (101 samples; operating periods 1..1, boundaries 0, 0.005 s)",
+        ),
+        (  # a window past the run
+            ["sensitivity", "one-stage", "--key", "design.mesh.damping_Ns_per_m=3000:12000"]
+            + ["--feature", "rms:signal=kd,from_s=1,to_s=2", "--samples", "2", "--t-end", "0.005"],
+            "--feature rms:signal=kd,from_s=1,to_s=2: window {'from_s': 1.0, 'to_s': 2.0}: fewer than 2 "
+            "samples in a run of operation.t_end_s = 0.005 s",
+        ),
+        (  # past the run of one sample row only: the varied t_end
+            ["sensitivity", "one-stage", "--key", "operation.t_end_s=0.004:0.02"]
+            + ["--feature", "kd_max:from_s=0.01", "--samples", "2"],
+            "(sample row ",
+        ),
+        (
+            ["calibrate", "one-stage", "--param", "design.mesh.damping_Ns_per_m=3000:12000"]
+            + ["--target", "kd_max:period=4", "1.2", "0.1", "--t-end", "0.003"],
+            "--target kd_max:period=4: period = 4: the record has periods 1..1 in a run of "
+            "operation.t_end_s = 0.003 s (the fixed overrides)",
+        ),
+    ],
+)
+def test_a_feature_window_the_run_cannot_hold_is_refused_before_any_run(
+    tmp_path, capsys, monkeypatch, argv, named
+):
+    import gearbody.engine
+
+    def no_simulation(*args, **kwargs):
+        raise AssertionError("a simulation ran before the feature window was checked")
+
+    monkeypatch.setattr(gearbody.engine, "simulate", no_simulation)
+    out = tmp_path / "study"
+    line = _one_line_refusal(capsys, [*argv, "--workers", "1", "--out", str(out)], named)
+    assert line.endswith("nothing was run")
+    assert not out.exists()
+
+
+def test_a_window_every_run_holds_passes_the_check():
+    from gearbody.analysis.features import parse_feature
+    from gearbody.model import load_scenario
+    from gearbody.studies.sensitivity import check_feature_windows
+
+    sc = load_scenario("one-stage", ["operation.t_end_s=1.3"])  # periods at 0, 0.5, 0.8, 1.2, 1.3 s
+    specs = [parse_feature(f) for f in ("kd_max:period=4", "kd_max:from_s=1.0,to_s=1.3", "kd_mean")]
+    check_feature_windows(sc, specs)
+    with pytest.raises(Exception, match=r"period = 5: the record has periods 1\.\.4"):
+        check_feature_windows(sc, [parse_feature("kd_max:period=5")])

@@ -42,7 +42,13 @@ from .calibration import (
 )
 from .executors import check_options, run_jobs
 from .parse import SweepSpecError, check_key
-from .sensitivity import check_feature_signals, evaluate_rows, read_scene, scene_features
+from .sensitivity import (
+    check_feature_signals,
+    check_feature_windows,
+    evaluate_rows,
+    read_scene,
+    scene_features,
+)
 from .store import write_json, write_text
 
 __all__ = ["MAX_EVALUATIONS", "SceneCalibration", "calibrate_scene", "parse_parameter", "parse_target"]
@@ -194,17 +200,19 @@ def calibrate_scene(
     label, base, sha = read_scene(scene)
     for case, extra in used.items():
         where = f"case {case!r}" if case else "the fixed overrides"
+        specs = [parse_feature(t.feature) for t in targets if t.case == case]
         try:
-            load_scenario(dict(base), [*overrides, *extra])
+            scenario = load_scenario(dict(base), [*overrides, *extra])
         except ScenarioError as exc:
             raise SweepSpecError(f"{where}: {exc}") from None
+        check_feature_windows(scenario, specs, f" ({where})", "--target")
         for p in parameters:
             for v in (p.lower, p.upper, *(() if p.start is None else (p.start,))):
                 try:
-                    load_scenario(dict(base), [*overrides, *extra, f"{p.key}={v!r}"])
+                    scenario = load_scenario(dict(base), [*overrides, *extra, f"{p.key}={v!r}"])
                 except ScenarioError as exc:
                     raise SweepSpecError(f"--param {p.key}: at {v!r} ({where}): {exc}") from None
-        specs = [parse_feature(t.feature) for t in targets if t.case == case]
+                check_feature_windows(scenario, specs, f" (--param {p.key} at {v!r}, {where})", "--target")
         check_feature_signals(base, [*overrides, *extra], specs)
 
     features = {case: tuple(dict.fromkeys(t.feature for t in targets if t.case == case)) for case in used}
