@@ -507,3 +507,35 @@ def test_a_window_every_run_holds_passes_the_check():
     check_feature_windows(sc, specs)
     with pytest.raises(Exception, match=r"period = 5: the record has periods 1\.\.4"):
         check_feature_windows(sc, [parse_feature("kd_max:period=5")])
+
+
+@pytest.mark.parametrize(
+    ("scene", "override", "named"),
+    [  # on main: "LinearBearing.stiffness_x_N_per_m = -1.0" and "HertzianBearing.__init__() got an unexpected
+        # keyword argument 'bogus'"
+        (
+            "lateral-8dof",
+            "design.pinion.bearing.parameters.stiffness_x_N_per_m=-1",
+            "design.pinion.bearing.parameters.stiffness_x_N_per_m = -1.0: must be > 0",
+        ),
+        (
+            "lateral-8dof-ball",
+            "design.pinion.bearing.parameters.exponent=3",
+            "design.pinion.bearing.parameters.exponent = 3.0: must be in [1, 2]",
+        ),
+        (
+            "lateral-8dof-ball",
+            "design.pinion.bearing.parameters.bogus=3",
+            "design.pinion.bearing.parameters.bogus = 3.0: not a parameter of the 'hertzian' law, which "
+            "takes contact_stiffness_N_per_m_n, radial_clearance_m, exponent, damping_Ns_per_m",
+        ),
+        (
+            "lateral-8dof-ball",
+            "design.pinion.bearing.parameters={radial_clearance_m=1e-6}",
+            "design.pinion.bearing.parameters.contact_stiffness_N_per_m_n: required by the 'hertzian' law",
+        ),
+    ],
+)
+def test_bearing_law_refusals_name_the_parameter_as_written(tmp_path, capsys, scene, override, named):
+    line = _one_line_refusal(capsys, ["run", scene, "--set", override, "--out", str(tmp_path / "r")], named)
+    assert "Bearing." not in line and "__init__" not in line
