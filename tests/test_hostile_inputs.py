@@ -539,3 +539,13 @@ def test_a_window_every_run_holds_passes_the_check():
 def test_bearing_law_refusals_name_the_parameter_as_written(tmp_path, capsys, scene, override, named):
     line = _one_line_refusal(capsys, ["run", scene, "--set", override, "--out", str(tmp_path / "r")], named)
     assert "Bearing." not in line and "__init__" not in line
+
+
+def test_a_run_refused_by_the_mode_check_leaves_no_folder(tmp_path, capsys):
+    out = tmp_path / "run"
+    key = "design.pinion.bearing.parameters.stiffness_x_N_per_m"
+    argv = ["run", "lateral-8dof", "--set", f"{key}=1e20", "--t-end", "0.01", "--out", str(out)]
+    _one_line_refusal(
+        capsys, argv, "design.stages.1.pinion.mass_kg = 7.78 kg: against its stiffness (1e+20 N/m"
+    )
+    assert not out.exists()

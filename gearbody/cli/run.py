@@ -100,9 +100,9 @@ def execute(args) -> int:
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
     if not args.no_plots or args.report:
         check_plottable(scenario, args)
-    out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     result = simulate(scenario, progress=not args.quiet)
+    out.mkdir(parents=True, exist_ok=True)  # after the run: a refusal or a failed run leaves no folder
     result.save_npz(out / "result.npz")
     dump_scenario(scenario, out / "scenario.toml")
     summary = result.summary()
