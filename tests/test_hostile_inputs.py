@@ -549,3 +549,26 @@ def test_a_run_refused_by_the_mode_check_leaves_no_folder(tmp_path, capsys):
         capsys, argv, "design.stages.1.pinion.mass_kg = 7.78 kg: against its stiffness (1e+20 N/m"
     )
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "named"),
+    [
+        (
+            ["sweep", "one-stage", "--vary", "production.error_mode.e_um=" + "[" * 40 + "1" + "]" * 40],
+            "--vary ",
+        ),
+        (
+            ["sweep", "one-stage", "--vary", "production.error_mode.e_um=1," + "[" * 600 + "]" * 600],
+            "--vary ",
+        ),
+        (
+            ["calibrate", "one-stage", "--param", "design.mesh.damping_Ns_per_m=3000:12000"]
+            + ["--target", "kd_max@c", "1.2", "0.1", "--case", "c", "a=" + "[" * 600 + "]" * 600],
+            "--case c 'a=",
+        ),
+    ],
+)
+def test_study_values_nested_too_deep_are_refused_naming_the_option(tmp_path, capsys, argv, named):
+    line = _one_line_refusal(capsys, [*argv, "--out", str(tmp_path / "study")], "more than 32 levels deep")
+    assert named in line and "--set" not in line

@@ -155,6 +155,7 @@ def calibrate_scene(
     ImportError (nevergrad or dask missing)."""
     from gearbody.analysis.features import FeatureError, parse_feature
     from gearbody.model import ScenarioError, load_scenario, parse_override
+    from gearbody.model.io import override_label
 
     t0 = time.perf_counter()
     parameters, targets = tuple(parameters), tuple(targets)
@@ -192,11 +193,14 @@ def calibrate_scene(
     keys = [p.key for p in parameters]
     if len(set(keys)) != len(keys):
         raise SweepSpecError(f"a --param is given twice: {keys}")
-    for o in (*overrides, *(o for c in used.values() for o in c)):
-        if parse_override(o)[0] in keys:
-            raise SweepSpecError(
-                f"override {o}: {parse_override(o)[0]} is also a --param; give it in one place"
-            )
+    given = [(o, None) for o in overrides]
+    given += [
+        (o, f"--case {c} {override_label(o).removeprefix('--set ')}") for c, os in used.items() for o in os
+    ]
+    for o, typed in given:  # a case's override named as --case NAME KEY=VALUE
+        key = parse_override(o, typed)[0]
+        if key in keys:
+            raise SweepSpecError(f"override {o}: {key} is also a --param; give it in one place")
     label, base, sha = read_scene(scene)
     for case, extra in used.items():
         where = f"case {case!r}" if case else "the fixed overrides"

@@ -278,7 +278,7 @@ def _vary_axes(
         texts = tuple(toml_literal(v) for v in values)
         if len(set(texts)) != len(texts):
             raise SweepSpecError(f"{label}: repeated value in {values!r}")
-        axes.append(Axis(key, texts, tuple(toml_value(t) for t in texts), label))
+        axes.append(Axis(key, texts, tuple(toml_value(t, label) for t in texts), label))
     return tuple(axes)
 
 
