@@ -389,6 +389,8 @@ class Claim:
     mode: str
     lock: FolderLock
     option: str = "--out"
+    created: bool = False
+    """The folder did not exist before: a command that fails before writing anything leaves none."""
 
     def begin(self, keep: Iterable[Path] = ()) -> None:
         """Just before the first output is written: the old outputs go (but ``keep``: an input read
@@ -423,8 +425,20 @@ class Claim:
     def __enter__(self) -> Claim:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, exc_type, *exc) -> None:
         self.release()
+        if exc_type is not None and self.created:
+            _remove_if_unused(self.path)
+
+
+def _remove_if_unused(folder: Path) -> None:
+    """Remove a folder a failed command created, if it holds nothing but the lock file."""
+    try:
+        if {p.name for p in folder.iterdir()} <= {LOCK}:
+            (folder / LOCK).unlink(missing_ok=True)
+            folder.rmdir()
+    except OSError:
+        pass  # someone else's by now, or not ours to remove
 
 
 def claim(
@@ -445,6 +459,7 @@ def claim(
     if command not in KINDS:
         raise ValueError(f"command {command!r}: one of {', '.join(KINDS)}")
     folder = Path(path)
+    created = not folder.exists()
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -464,7 +479,7 @@ def claim(
     except BaseException:
         lock.release()
         raise
-    return Claim(folder, command, identity, state, mode, lock, option)
+    return Claim(folder, command, identity, state, mode, lock, option, created)
 
 
 def _same(command: str, state: FolderState, identity: dict[str, Any] | None) -> bool:

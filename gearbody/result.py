@@ -483,15 +483,15 @@ class Result:
     def period_boundaries_s(self) -> tuple[float, ...]:
         """The run's operating periods: its start, every breakpoint of the speed and load profiles inside
         the run, its end [s] (the four-period runs: 0, run-up end, load start, load rated, t_end)."""
-        t0, t1 = float(self.time_s[0]), float(self.time_s[-1])
+        from .analysis.features import operating_periods_s
+
         operation = self.meta.get("scenario", {}).get("operation", {})
-        inner = {
-            float(t)
+        times = [
+            t
             for profile in ("speed_profile", "load_profile")
             for t in operation.get(profile, {}).get("time_s", ())
-            if t0 < float(t) < t1
-        }
-        return (t0, *sorted(inner), t1)
+        ]
+        return operating_periods_s(float(self.time_s[0]), float(self.time_s[-1]), times)
 
     def record(self, natural_frequencies_hz=()):
         """The run as an :class:`~gearbody.analysis.features.Record` for features (``natural_frequencies_hz``:

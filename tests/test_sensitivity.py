@@ -385,12 +385,17 @@ def test_a_key_that_cannot_affect_the_features_gets_zero_on_gearbody(tmp_path, c
 
 
 def test_cli_runs_that_fail_exit_1_recorded_with_their_cause(tmp_path, capsys):
-    """A steady run has one operating period: kd_max:period=2 fails in every run (4 runs)."""
+    """The final quarter of a 0.03 s run holds 0.18 pinion revolutions: a synchronous average over 2 or more
+    fails in every run (4 runs), found only once the speed is known."""
     out = tmp_path / "failing"
-    argv = ["sensitivity", "one-stage", "--key", f"{STIFFNESS}=1.0e9:1.25e9", "--feature", "kd_max:period=2"]
+    feature = "fm4:signal=pinion_accel_rad_s2"
+    argv = ["sensitivity", "one-stage", "--key", f"{STIFFNESS}=1.0e9:1.25e9", "--feature", feature]
     assert main([*argv, "--samples", "2", *ONE_STAGE, "--out", str(out)]) == 1
     err = capsys.readouterr().err
-    assert "4 of 4 rows failed or missing (rows 0, 1, 2, 3; row 0: FeatureError: period = 2" in err
+    assert (
+        f"4 of 4 rows failed or missing (rows 0, 1, 2, 3; row 0: FeatureError: feature {feature}: the window "
+        "holds less than 2 revolutions of the pinion"
+    ) in err
     assert "--exclude-failed" in err and not (out / "indices.csv").exists()
     entries = [json.loads(p.read_text())["rows"][0] for p in sorted((out / "evaluations").glob("*.json"))]
     assert [e["error_type"] for e in entries] == ["FeatureError"] * 4

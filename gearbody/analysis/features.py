@@ -63,6 +63,7 @@ __all__ = [
     "line_amplitude",
     "line_frequency_hz",
     "natural_frequency_hz",
+    "operating_periods_s",
     "parse_feature",
     "resonance_speed",
 ]
@@ -180,6 +181,13 @@ def resonance_speed(speeds: ArrayLike, response: ArrayLike) -> tuple[float, bool
 
 
 # -- records and specs ----------------------------------------------------------------------------------
+def operating_periods_s(t0_s: float, t1_s: float, profile_times_s: Sequence[float]) -> tuple[float, ...]:
+    """The operating periods of a run from ``t0_s`` to ``t1_s``: its start, every breakpoint of its speed
+    and load profiles (``profile_times_s``) inside the run, its end [s]."""
+    inner = {float(t) for t in profile_times_s if t0_s < float(t) < t1_s}
+    return (float(t0_s), *sorted(inner), float(t1_s))
+
+
 @dataclass(frozen=True)
 class Record:
     """Signals on one uniform time grid and the facts of the drive that features need.

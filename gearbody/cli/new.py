@@ -58,15 +58,16 @@ def execute(args) -> int:
     from gearbody.errors import InputError
     from gearbody.folders import write_text
     from gearbody.model import load_scenario
-    from gearbody.model.io import apply_overrides, read_toml
+    from gearbody.model.io import apply_overrides, parse_scenario_bytes, read_scenario_bytes
     from gearbody.model.shorthand import canonical_form
     from gearbody.model.template import commented_toml, header_comment
     from gearbody.version import __version__
 
     scenario = load_scenario(args.scene, args.overrides)  # refuses a bad scene or override (exit 2)
     source = _scene_file(args.scene)
-    text = source.read_text()
-    given, _ = canonical_form(read_toml(source), str(source))
+    data = read_scenario_bytes(source)  # a regular file within the size limit (checked by load_scenario too)
+    text = data.decode("utf-8")
+    given, _ = canonical_form(parse_scenario_bytes(data, source), str(source))
     _, _, origins = apply_overrides(given, args.overrides)
     out = args.out if args.out is not None else Path(f"{scenario.meta.name or source.stem}.toml")
     command = "gearbody new " + " ".join([args.scene, *(f"--set {o}" for o in args.overrides)])

@@ -255,7 +255,10 @@ def execute(args) -> int:
         )
         folder.finish()
     except RenderError as exc:
-        return usage_error("render", str(exc))
+        message = str(exc)
+        if args.result is not None and message.startswith("result: "):  # name the file the user gave
+            message = f"--result = {args.result}: " + message.removeprefix("result: ")
+        return usage_error("render", message)
     finally:
         stack.close()
     if not args.quiet:

@@ -72,6 +72,29 @@ PLANETARY_SHOWN = (
 )
 
 
+def check_plottable(scenario, args) -> None:
+    """InputError (exit 2, before anything runs) when the run gives too few output samples for the plots
+    and the report it is asked to write (gearbody.plotting.run.MIN_PLOT_SAMPLES), naming the simulated
+    time that does and --no-plots."""
+    from gearbody.errors import InputError
+    from gearbody.model.budget import output_samples
+    from gearbody.plotting.run import MIN_PLOT_SAMPLES
+
+    samples = output_samples(scenario)
+    if samples >= MIN_PLOT_SAMPLES:
+        return
+    rate = scenario.solver.output_rate_hz
+    t_end = scenario.operation.t_end_s
+    option = "--t-end" if args.t_end is not None else "operation.t_end_s"
+    wanted = "the plots and the report analyse" if args.report else "the plots analyse"
+    raise InputError(
+        f"{option} = {t_end:g}: {samples} output samples at solver.output_rate_hz = {rate:g} Hz; {wanted} "
+        f"the last 25 % of the run and need at least {MIN_PLOT_SAMPLES}; allowed: {option} >= "
+        f"{(MIN_PLOT_SAMPLES - 1) / rate:g}, or --no-plots{' without --report' if args.report else ''} to "
+        "write result.npz, scenario.toml and summary.json only"
+    )
+
+
 def execute(args) -> int:
     out = check_out(args.out or default_out(args.scene))  # before anything is imported or run
     from gearbody.engine import simulate
@@ -79,6 +102,8 @@ def execute(args) -> int:
     from gearbody.model import dump_scenario, scenario_to_dict
 
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
+    if not args.no_plots or args.report:
+        check_plottable(scenario, args)
     identity = {"scenario": scenario_to_dict(scenario)}  # what makes a run the same run
     with claim(out, "run", identity, overwrite=args.overwrite) as folder:  # locked while it writes
         t0 = time.perf_counter()

@@ -112,6 +112,11 @@ def _pinion_speeds_rad_s(scenario: Scenario) -> list[float]:
     return speeds
 
 
+def output_samples(scenario: Scenario) -> int:
+    """Samples of the run's output grid, t_k = k / solver.output_rate_hz for k = 0 .. floor(t_end rate)."""
+    return math.floor(scenario.operation.t_end_s * scenario.solver.output_rate_hz + 1e-9) + 1
+
+
 def output_memory_bytes(scenario: Scenario, oversampling_points: int) -> float:
     """Peak memory of the output sampling with ``oversampling_points`` fine points per sample, bytes."""
     samples = math.floor(scenario.operation.t_end_s * scenario.solver.output_rate_hz + 1e-9) + 1

@@ -54,16 +54,24 @@ class Bearing(Node):
                 f"bearing.kind = {self.kind!r}: not a registered bearing law; registered: "
                 f"{', '.join(sorted(BEARINGS))}"
             )
+        cls = BEARINGS[self.kind]
+        signature = inspect.signature(cls).parameters
+        law = f"the {self.kind!r} law, which takes {', '.join(signature)}"
+        for name, value in self.parameters.items():  # named as the user wrote them, not as Python's
+            if name not in signature:
+                raise ScenarioError(f"parameters.{name} = {value!r}: not a parameter of {law}")
+        for name, p in signature.items():
+            if p.default is p.empty and name not in self.parameters:
+                raise ScenarioError(f"parameters.{name}: required by {law}")
         try:
             return make_bearing(self.kind, **self.parameters)
         except TypeError as exc:
-            names = list(inspect.signature(BEARINGS[self.kind]).parameters)
-            raise ScenarioError(
-                f"bearing.parameters = {self.parameters}: {exc}; "
-                f"the {self.kind!r} law takes {', '.join(names)}"
-            ) from None
-        except ValueError as exc:
-            raise ScenarioError(f"bearing.parameters: {exc}") from None
+            raise ScenarioError(f"bearing.parameters = {self.parameters}: {exc}; {law}") from None
+        except ValueError as exc:  # the law's own check: 'LinearBearing.stiffness_x_N_per_m = ...'
+            text = str(exc)
+            if text.startswith(f"{cls.__name__}."):
+                raise ScenarioError("parameters." + text.removeprefix(f"{cls.__name__}.")) from None
+            raise ScenarioError(f"bearing.parameters: {text}") from None
 
 
 LATERAL = ("none", "y", "xy")

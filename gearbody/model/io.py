@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import copy
+import os
 import shlex
+import stat
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -22,19 +24,127 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 
-def read_toml(path: str | Path) -> dict[str, Any]:
-    """Read a TOML file; a missing, unreadable, binary or non-UTF-8 file or a syntax error is a
-    one-line ScenarioError naming the file."""
+MAX_SCENARIO_BYTES = 1 << 20
+"""Largest scenario file read [bytes], 1 MiB. The shipped scenes are 1.4-4.2 kB and ``gearbody new`` writes
+10-22 kB; 1 MiB still holds a measured speed or load profile of 25,000 points (two arrays of ~20
+characters a value: 0.99 MB), while a device (``/dev/zero``), a huge file or a file that grows is
+refused before it fills memory."""
+
+MAX_NESTING = 32
+"""Deepest nesting of tables and arrays in a scenario (a file, or a ``--set`` key and value). The deepest
+scenario key, ``design.stages.N.sun.bearing.parameters.K``, nests 7 levels (the file's top table
+counted); 32 leaves room while every recursive reader (the TOML parser, copies, validation) stays far
+below Python's recursion limit (1000 frames: a TOML array nested ~500 deep or a 900-part table header
+exhausted it)."""
+
+_SPECIAL_FILES = (
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def _not_regular(path: Path, mode: int, what: str) -> ScenarioError:
+    if stat.S_ISDIR(mode):
+        return ScenarioError(f"{path}: is a folder, not a scenario file ({what})")
+    kind = next((name for test, name in _SPECIAL_FILES if test(mode)), "not a regular file")
+    return ScenarioError(f"{path}: {kind}, not a scenario file ({what}; only regular files are read)")
+
+
+def read_scenario_bytes(path: str | Path) -> bytes:
+    """The bytes of a scenario file: a regular file of at most MAX_SCENARIO_BYTES, else a one-line
+    ScenarioError naming the file (missing, unreadable, a folder, a FIFO or device, too large).
+
+    The file is checked before it is opened (``os.stat``) and again once open (``os.fstat``); it is
+    opened non-blocking, so a FIFO put in its place in between cannot block, and at most one byte more
+    than the limit is ever read."""
     path = Path(path)
     what = "a scenario is a UTF-8 TOML text file"
-    if path.is_dir():
-        raise ScenarioError(f"{path}: is a folder, not a scenario file ({what})")
     try:
-        data = path.read_bytes()
+        mode = os.stat(path).st_mode
+        if not stat.S_ISREG(mode):
+            raise _not_regular(path, mode, what)
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
     except FileNotFoundError:
         raise ScenarioError(f"{path}: no such scenario file") from None
     except OSError as exc:
         raise ScenarioError(f"{path}: cannot read the scenario file: {exc.strerror or exc}") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise _not_regular(path, info.st_mode, what)
+        chunks, size = [], 0
+        while size <= MAX_SCENARIO_BYTES:
+            chunk = os.read(fd, MAX_SCENARIO_BYTES + 1 - size)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+    except OSError as exc:
+        raise ScenarioError(f"{path}: cannot read the scenario file: {exc.strerror or exc}") from None
+    finally:
+        os.close(fd)
+    if size > MAX_SCENARIO_BYTES:
+        shown = f"{info.st_size} bytes" if info.st_size > MAX_SCENARIO_BYTES else "it grew while read"
+        raise ScenarioError(
+            f"{path}: too large for a scenario file ({shown}); allowed: at most {MAX_SCENARIO_BYTES} bytes "
+            "(1 MiB)"
+        )
+    return b"".join(chunks)
+
+
+def nesting_depth(value: Any) -> int:
+    """Levels of tables and arrays in ``value`` (0 for a plain value), counted without recursion."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if isinstance(node, dict):
+            children = node.values()
+        elif isinstance(node, (list, tuple)):
+            children = node
+        else:
+            continue
+        deepest = max(deepest, depth)
+        if depth <= MAX_NESTING:  # deeper is refused anyway: stop counting there
+            stack.extend((child, depth + 1) for child in children)
+    return deepest
+
+
+def _too_deep(where: str) -> ScenarioError:
+    return ScenarioError(
+        f"{where}: tables and arrays nested more than {MAX_NESTING} levels deep; allowed: at most "
+        f"{MAX_NESTING} (a scenario needs 7)"
+    )
+
+
+def _parse_toml(text: str, where: str) -> dict[str, Any]:
+    """``tomllib.loads`` with its failures as one-line ScenarioErrors naming ``where``; nesting deeper
+    than MAX_NESTING is refused."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{where}: not valid TOML: {exc}") from None
+    except RecursionError:  # the parser recurses per level: only hundreds of levels get here
+        raise _too_deep(where) from None
+    except ValueError:  # Python reads integers of at most 4300 digits
+        raise ScenarioError(f"{where}: unreadable value: an integer of more than 4300 digits") from None
+    if nesting_depth(data) > MAX_NESTING:
+        raise _too_deep(where)
+    return data
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML file; a missing, unreadable, binary or non-UTF-8 file, one that is not a regular file
+    (a folder, FIFO, device), one larger than MAX_SCENARIO_BYTES, nested deeper than MAX_NESTING or with a
+    syntax error is a one-line ScenarioError naming the file."""
+    return parse_scenario_bytes(read_scenario_bytes(path), path)
+
+
+def parse_scenario_bytes(data: bytes, path: str | Path) -> dict[str, Any]:
+    """The TOML data of a scenario file's bytes (:func:`read_scenario_bytes`); errors name ``path``."""
+    path = Path(path)
+    what = "a scenario is a UTF-8 TOML text file"
     if path.suffix == ".npz" or data.startswith(b"PK\x03\x04"):
         raise ScenarioError(f"{path}: a zip/npz archive (a result?), not a scenario file ({what})")
     try:
@@ -45,12 +155,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         ) from None
     if "\x00" in text:
         raise ScenarioError(f"{path}: a binary file (contains NUL bytes), not a scenario file ({what})")
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
-    except ValueError:  # Python reads integers of at most 4300 digits
-        raise ScenarioError(f"{path}: unreadable value: an integer of more than 4300 digits") from None
+    return _parse_toml(text, str(path))
 
 
 def override_label(text: str, limit: int = 200) -> str:
@@ -77,9 +182,22 @@ def parse_override(text: str, label: str | None = None) -> tuple[str, Any]:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
+    except RecursionError:  # the parser recurses per level: only hundreds of levels get here
+        raise _too_deep(label) from None
     except ValueError:  # Python reads integers of at most 4300 digits
         raise ScenarioError(f"{label}: unreadable value: an integer of more than 4300 digits") from None
+    _check_override_depth(key, value, label)
     return key, value
+
+
+def _check_override_depth(key: str, value: Any, label: str) -> None:
+    """The levels a ``KEY=VALUE`` adds to a scenario (key parts, then the value's tables and arrays)
+    stay within MAX_NESTING."""
+    if key.count(".") + 1 + nesting_depth(value) > MAX_NESTING:
+        raise ScenarioError(
+            f"{label}: nests more than {MAX_NESTING} levels deep (the key's parts, then the value's tables "
+            f"and arrays); allowed: at most {MAX_NESTING} (a scenario needs 7)"
+        )
 
 
 def apply_overrides(
@@ -104,6 +222,8 @@ def apply_overrides(
         labels = list(labels) if labels is not None else [override_label(o) for o in overrides]
         items = [(lab, *parse_override(o, lab)) for o, lab in zip(overrides, labels, strict=True)]
     else:
+        for k, v in overrides.items():  # before repr() of a value (it recurses)
+            _check_override_depth(k, v, f"override {k}")
         items = [(f"override {k}={v!r}", k, v) for k, v in overrides.items()]
     for label, key, value in items:
         if key == "meta.scene":  # the older name of meta.topology
@@ -173,6 +293,8 @@ def load_scenario(
     caused by an override quote it as typed (``labels``: one per override, default ``--set KEY=VALUE``)."""
     if isinstance(source, dict):
         data, name, stem = source, "<dict>", ""
+        if nesting_depth(data) > MAX_NESTING:
+            raise _too_deep(name)
     else:
         path = Path(source)
         if not path.suffix and not path.exists():

@@ -5,6 +5,8 @@ of docs/planetary.md, "The stage in a drive"."""
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -184,7 +186,7 @@ class PlanetaryStage(Node):
         try:
             self.geometry  # noqa: B018  (assembly condition, spacing, overlap: refused before anything runs)
         except PlanetaryGeometryError as exc:
-            raise ScenarioError(_stage_geometry_message(str(exc))) from None
+            raise ScenarioError(_stage_geometry_message(str(exc), self.planet_angles_deg)) from None
 
     def _check_angles(self) -> None:
         """Given planet angles, in degrees: one per planet, the first 0, increasing below 360, each on the
@@ -377,14 +379,23 @@ class PlanetaryStage(Node):
         return 3 * (3 + self.planets)
 
 
-def _stage_geometry_message(text: str) -> str:
-    """A PlanetaryGeometry message in the stage's own key names."""
+def _stage_geometry_message(text: str, angles_deg: Sequence[float] = ()) -> str:
+    """A PlanetaryGeometry message in the stage's own key names: ``planet_angles_rad[k] = <rad>`` (0-based,
+    radians) becomes ``planet_angles_deg.<k + 1> = <the degrees given>``."""
+
+    def angle(match: re.Match) -> str:
+        k = int(match[1])
+        value = angles_deg[k] if k < len(angles_deg) else math.degrees(float(match[2]))
+        return f"planet_angles_deg.{k + 1} = {value:g}"
+
+    text = re.sub(r"planet_angles_rad\[(\d+)\] = ([-+0-9.eE]+)", angle, text)
     for old, new in (
         ("z_sun", "sun.teeth"),
         ("z_planet", "planet.teeth"),
         ("z_ring", "ring.teeth"),
         ("n_planets", "planets"),
         ("module_m ", "module_mm "),
+        ("planet_angles_rad", "planet_angles_deg"),
     ):
         text = text.replace(old, new)
     return text

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -39,6 +39,9 @@ class BearingLaw(Protocol):
 @dataclass(frozen=True)
 class LinearBearing:
     """Linear spring-damper per direction (the paper's k_x, k_y, C_x, C_y of Figs. 17-18)."""
+
+    STIFFNESS_PARAMETERS: ClassVar[tuple[str, str]] = ("stiffness_x_N_per_m", "stiffness_y_N_per_m")
+    DAMPING_PARAMETERS: ClassVar[tuple[str, str]] = ("damping_x_Ns_per_m", "damping_y_Ns_per_m")
 
     stiffness_x_N_per_m: float
     stiffness_y_N_per_m: float
@@ -72,6 +75,9 @@ class HertzianBearing:
     (10/9 is used for roller bearings), plus a radial damping ``C u_r'`` while in contact. This is the
     lumped (isotropic) form; a per-element model with ball passage is a later refinement.
     """
+
+    STIFFNESS_PARAMETERS: ClassVar[tuple[str, str]] = ("contact_stiffness_N_per_m_n",) * 2
+    DAMPING_PARAMETERS: ClassVar[tuple[str, str]] = ("damping_Ns_per_m",) * 2
 
     contact_stiffness_N_per_m_n: float
     radial_clearance_m: float = 0.0
@@ -117,6 +123,27 @@ class HertzianBearing:
         """Elastic energy stored in the contact (for checks): k_b p^(n+1) / (n+1)."""
         p = max(0.0, math.hypot(*np.asarray(displacement_m, float)) - self.radial_clearance_m)
         return self.contact_stiffness_N_per_m_n * p ** (self.exponent + 1) / (self.exponent + 1)
+
+
+def tangent_stiffness_damping(
+    law: BearingLaw, displacement_m: np.ndarray | tuple[float, float] = (0.0, 0.0)
+) -> tuple[np.ndarray, np.ndarray]:
+    """(k_xx, k_yy) [N/m] and (c_xx, c_yy) [N s/m]: the diagonal of -dF/du and -dF/dv of any bearing law
+    at ``displacement_m`` at rest, by central differences (exact for the linear law; a Hertzian law's
+    radial tangent n k_b p^(n-1) along the displacement and F / |u| across it, its damping while in
+    contact). Steps: 1e-6 of |u| (at least 1e-12 m) and 1e-6 m/s."""
+    u0 = np.asarray(displacement_m, dtype=float).reshape(2)
+    h_u = max(1e-6 * float(np.hypot(*u0)), 1e-12)
+    h_v = 1e-6
+    k, c = np.zeros(2), np.zeros(2)
+    zero = np.zeros(2)
+    for d in range(2):
+        e = np.zeros(2)
+        e[d] = 1.0
+        force = law.force_N
+        k[d] = -(force(u0 + h_u * e, zero)[d] - force(u0 - h_u * e, zero)[d]) / (2.0 * h_u)
+        c[d] = -(force(u0, h_v * e)[d] - force(u0, -h_v * e)[d]) / (2.0 * h_v)
+    return k, c
 
 
 BEARINGS: dict[str, type] = {"linear": LinearBearing, "hertzian": HertzianBearing}

@@ -197,9 +197,10 @@ class PlanetaryGeometry:
         distance = 2.0 * self.carrier_radius_m * math.sin(gaps[k] / 2.0)
         tip_diameter = 2.0 * self.planet_tip_radius_m
         if not distance > tip_diameter:
+            moved = k + 1 if k + 1 < self.n_planets else k  # the later planet; planet 1 stays at 0
             raise _error(
-                f"planet_angles_rad[{(k + 1) % self.n_planets}]" if given else "n_planets",
-                self.planet_angles_rad[(k + 1) % self.n_planets] if given else self.n_planets,
+                f"planet_angles_rad[{moved}]" if given else "n_planets",
+                self.planet_angles_rad[moved] if given else self.n_planets,
                 f"planets {k + 1} and {(k + 1) % self.n_planets + 1} overlap: centres {distance:.6g} m "
                 f"apart, tip diameter {tip_diameter:.6g} m (z_planet = {self.z_planet})",
                 "centre distance between neighbouring planets > planet tip diameter",

@@ -16,7 +16,12 @@ if TYPE_CHECKING:  # Result.plot() calls this module
 
 from .result import plot_kd_folded, plot_kd_time, plot_signals, plot_spectrum
 
-__all__ = ["parallel_stage_plot_names", "write_plots"]
+__all__ = ["MIN_PLOT_SAMPLES", "parallel_stage_plot_names", "write_plots"]
+
+MIN_PLOT_SAMPLES = 64
+"""Fewest output samples a run's plots and report are drawn from: they analyse its final window (the last
+25 %, :meth:`Result.final_window`), which then holds 16 samples, a spectrum of 9 lines. With 3 samples
+(``--t-end 1e-4``) the spectrum had a single one; all scenes plot from 41."""
 
 
 def parallel_stage_plot_names(result: Result) -> list[str]:

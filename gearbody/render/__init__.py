@@ -18,7 +18,15 @@ from ..model.planetary import PlanetaryStage
 from ..result import Result
 from .layout import Layout, build_layout
 from .movie import FORMATS, ffmpeg_available, write_gif, write_mp4, write_png
-from .poses import MAX_FRAMES, RenderError, body_poses, check_frames, frame_times, kinematic_result
+from .poses import (
+    MAX_FRAMES,
+    RenderError,
+    body_poses,
+    check_drawable,
+    check_frames,
+    frame_times,
+    kinematic_result,
+)
 from .scene3d import VIEWS, RenderOptions, has_display
 
 __all__ = [
@@ -85,6 +93,7 @@ def _motion(scenario: Scenario, result: Result | None, layout: Layout, until_s: 
         duration = max(2 * np.pi / speed, until_s)
         return kinematic_result(layout.input_factor * speed, duration, signal=layout.input_signal)
     check_result_matches(scenario, result)
+    check_drawable(layout, result)
     return result
 
 

@@ -153,6 +153,33 @@ def body_poses(
     return poses
 
 
+def drawn_signals(layout: Layout, result: Result) -> list[str]:
+    """The result's signals a drawing of ``layout`` reads: time, the input rotation, every body's rotation
+    and centre motion the result holds."""
+    names = ["time_s", layout.input_signal]
+    for b in layout.bodies:
+        names += [b.angle_signal, *(b.lateral_signals or ()), *(b.orbit.centre_signals if b.orbit else ())]
+    return [n for n in dict.fromkeys(names) if n in result]
+
+
+def check_drawable(layout: Layout, result: Result) -> None:
+    """RenderError naming the first signal the drawing reads that holds a NaN or an infinity (where and
+    how many), or a time axis that does not increase."""
+    t = np.asarray(result.time_s, dtype=float)
+    for name in drawn_signals(layout, result):
+        values = np.asarray(result[name], dtype=float)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            k = int(np.argmax(bad))
+            at = f"t = {t[k]:g} s" if name != "time_s" and np.isfinite(t[k]) else f"sample {k}"
+            raise RenderError(
+                f"result: {name} holds {int(bad.sum())} of {values.size} values that are not finite (NaN or "
+                f"inf, the first at {at}); nothing can be drawn from them: simulate the scene again"
+            )
+    if t.size > 1 and not np.all(np.diff(t) > 0):
+        raise RenderError("result: time_s does not increase strictly; nothing can be drawn from it")
+
+
 def kinematic_result(
     speed_rad_s: float, duration_s: float, samples: int = 2001, signal: str = "pinion_angle_rad"
 ) -> Result:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import shutil
 import signal
 import tempfile
@@ -35,6 +36,7 @@ __all__ = [
     "Job",
     "WorkerDied",
     "check_options",
+    "check_scheduler_address",
     "dask",
     "death_cause",
     "failure",
@@ -189,9 +191,10 @@ def run_dask(
     distributed = dask()
     own = isinstance(scheduler, str)
     if own:
+        check_scheduler_address(scheduler)
         try:
-            client = distributed.Client(scheduler, timeout="20s")
-        except (OSError, TimeoutError) as exc:
+            client = distributed.Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S:g}s")
+        except (OSError, TimeoutError, ValueError) as exc:  # nothing answers, or Dask refuses the address
             raise SweepSpecError(f"--scheduler {scheduler}: cannot connect: {exc}") from None
     else:
         client = scheduler  # an existing dask.distributed.Client
@@ -217,14 +220,51 @@ def run_dask(
             client.close()
 
 
+CONNECT_TIMEOUT_S = 20.0
+"""How long a study waits for the Dask scheduler of ``--scheduler`` before it gives up [s]: an address
+that answers nothing (no scheduler there, a firewall) fails after this, in one line (exit 2)."""
+
+DASK_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+"""The address schemes of a Dask scheduler that gearbody accepts (``inproc://`` lives in one process
+only: a command line cannot reach it)."""
+
+_ADDRESS = re.compile(
+    r"(?:(?P<scheme>[A-Za-z][A-Za-z0-9+.-]*)://)?(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):(?P<port>[0-9]+)"
+)
+
+
+def check_scheduler_address(address: str) -> None:
+    """SweepSpecError unless ``address`` is a Dask scheduler address, ``SCHEME://HOST:PORT`` with a
+    scheme of DASK_SCHEMES and a port 1..65535, or ``HOST:PORT`` (Dask's default scheme, tcp); nothing is
+    contacted."""
+    allowed = (
+        "allowed: SCHEME://HOST:PORT with SCHEME one of " + ", ".join(DASK_SCHEMES) + " and PORT 1..65535, "
+        "e.g. tcp://head:8786, or HOST:PORT (tcp)"
+    )
+    shown = f"--scheduler = {address!r}"
+    match = _ADDRESS.fullmatch(address) if isinstance(address, str) else None
+    if match is None:
+        raise SweepSpecError(f"{shown}: not a Dask scheduler address; {allowed}")
+    if match["scheme"] is not None and match["scheme"] not in DASK_SCHEMES:
+        raise SweepSpecError(
+            f"{shown}: the scheme {match['scheme']}:// is not one a study reaches a Dask scheduler by; "
+            + allowed
+        )
+    if not 1 <= int(match["port"]) <= 65535:
+        raise SweepSpecError(f"{shown}: port {int(match['port'])} does not exist; {allowed}")
+
+
 def check_options(workers: int | None, scheduler: Any | None) -> None:
-    """SweepSpecError for workers and scheduler together or a bad worker count; ImportError for a
-    scheduler without dask.distributed. Call before anything runs."""
+    """SweepSpecError for workers and scheduler together, a bad worker count or a scheduler address that
+    is malformed (:func:`check_scheduler_address`); ImportError for a scheduler without dask.distributed.
+    Call before anything runs."""
     if scheduler is not None and workers is not None:
         raise SweepSpecError("--workers and --scheduler exclude each other (the cluster has its workers)")
     if workers is not None and (isinstance(workers, bool) or int(workers) != workers or workers < 1):
         raise SweepSpecError(f"--workers must be a whole number >= 1, got {workers!r}")
     if scheduler is not None:
+        if isinstance(scheduler, str):
+            check_scheduler_address(scheduler)
         dask()  # clear ImportError before anything runs
 
 

@@ -64,9 +64,10 @@ def _split_top(text: str, sep: str) -> list[str]:
     return [p.strip() for p in parts]
 
 
-def toml_value(text: str) -> Any:
-    """A TOML literal's value, read as ``--set`` reads it (not valid TOML: the plain string)."""
-    return parse_override(f"v={text}")[1]
+def toml_value(text: str, label: str | None = None) -> Any:
+    """A TOML literal's value, read as ``--set`` reads it (not valid TOML: the plain string); errors name
+    ``label`` (the option as typed)."""
+    return parse_override(f"v={text}", label)[1]
 
 
 def toml_literal(value: Any) -> str:
@@ -156,7 +157,7 @@ def parse_vary(text: str, *, label: str | None = None, max_count: int = MAX_CASE
         raise SweepSpecError(f"{label}: empty value in the list {spec!r}")
     if len(set(texts)) != len(texts):
         raise SweepSpecError(f"{label}: repeated value in {spec!r}")
-    return Axis(key, tuple(texts), tuple(toml_value(t) for t in texts), label)
+    return Axis(key, tuple(texts), tuple(toml_value(t, label) for t in texts), label)
 
 
 @dataclass(frozen=True)
@@ -215,7 +216,7 @@ class RandomAxis:
         """The ``samples`` draws of this key (own stream: seeded by study seed and key)."""
         rng = np.random.default_rng([study_seed, zlib.crc32(self.key.encode())])
         texts = tuple(self.distribution.draw_texts(rng, samples))
-        return Axis(self.key, texts, tuple(toml_value(t) for t in texts), self.label)
+        return Axis(self.key, texts, tuple(toml_value(t, self.label) for t in texts), self.label)
 
 
 def parse_random(text: str, *, label: str | None = None) -> RandomAxis:

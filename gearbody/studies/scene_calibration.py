@@ -43,7 +43,13 @@ from .calibration import (
 )
 from .executors import check_options, run_jobs
 from .parse import SweepSpecError, check_key
-from .sensitivity import check_feature_signals, evaluate_rows, read_scene, scene_features
+from .sensitivity import (
+    check_feature_signals,
+    check_feature_windows,
+    evaluate_rows,
+    read_scene,
+    scene_features,
+)
 from .store import write_json, write_text
 
 __all__ = ["MAX_EVALUATIONS", "SceneCalibration", "calibrate_scene", "parse_parameter", "parse_target"]
@@ -156,6 +162,7 @@ def calibrate_scene(
     ImportError (nevergrad or dask missing)."""
     from gearbody.analysis.features import FeatureError, parse_feature
     from gearbody.model import ScenarioError, load_scenario, parse_override
+    from gearbody.model.io import override_label
 
     t0 = time.perf_counter()
     parameters, targets = tuple(parameters), tuple(targets)
@@ -193,25 +200,30 @@ def calibrate_scene(
     keys = [p.key for p in parameters]
     if len(set(keys)) != len(keys):
         raise SweepSpecError(f"a --param is given twice: {keys}")
-    for o in (*overrides, *(o for c in used.values() for o in c)):
-        if parse_override(o)[0] in keys:
-            raise SweepSpecError(
-                f"override {o}: {parse_override(o)[0]} is also a --param; give it in one place"
-            )
+    given = [(o, None) for o in overrides]
+    given += [
+        (o, f"--case {c} {override_label(o).removeprefix('--set ')}") for c, os in used.items() for o in os
+    ]
+    for o, typed in given:  # a case's override named as --case NAME KEY=VALUE
+        key = parse_override(o, typed)[0]
+        if key in keys:
+            raise SweepSpecError(f"override {o}: {key} is also a --param; give it in one place")
     label, base, sha = read_scene(scene)
     for case, extra in used.items():
         where = f"case {case!r}" if case else "the fixed overrides"
+        specs = [parse_feature(t.feature) for t in targets if t.case == case]
         try:
-            load_scenario(dict(base), [*overrides, *extra])
+            scenario = load_scenario(dict(base), [*overrides, *extra])
         except ScenarioError as exc:
             raise SweepSpecError(f"{where}: {exc}") from None
+        check_feature_windows(scenario, specs, f" ({where})", "--target")
         for p in parameters:
             for v in (p.lower, p.upper, *(() if p.start is None else (p.start,))):
                 try:
-                    load_scenario(dict(base), [*overrides, *extra, f"{p.key}={v!r}"])
+                    scenario = load_scenario(dict(base), [*overrides, *extra, f"{p.key}={v!r}"])
                 except ScenarioError as exc:
                     raise SweepSpecError(f"--param {p.key}: at {v!r} ({where}): {exc}") from None
-        specs = [parse_feature(t.feature) for t in targets if t.case == case]
+                check_feature_windows(scenario, specs, f" (--param {p.key} at {v!r}, {where})", "--target")
         check_feature_signals(base, [*overrides, *extra], specs)
 
     features = {case: tuple(dict.fromkeys(t.feature for t in targets if t.case == case)) for case in used}

@@ -580,20 +580,19 @@ def scene_features(
 
 def read_scene(scene: str | Path) -> tuple[str, dict[str, Any], str]:
     """(label stored in the spec, TOML data, sha256 of the file) of a scene name or TOML path."""
-    from gearbody.model import ScenarioError, scene_path
-    from gearbody.model.io import read_toml
+    from gearbody.model import scene_path
+    from gearbody.model.io import parse_scenario_bytes, read_scenario_bytes
 
     path = Path(scene)
     if not path.suffix and not path.exists():
         label, path = str(scene), scene_path(str(scene))
-    elif not path.is_file():
-        raise ScenarioError(f"{path}: no such scenario file")
     else:
         label = str(path.resolve())
-    base = read_toml(path)
+    data = read_scenario_bytes(path)  # refuses a missing file, a folder, a FIFO, a device, a huge file
+    base = parse_scenario_bytes(data, path)
     if isinstance(base.get("meta"), dict):
         base["meta"].setdefault("name", path.stem)
-    return label, base, hashlib.sha256(path.read_bytes()).hexdigest()
+    return label, base, hashlib.sha256(data).hexdigest()
 
 
 def sensitivity(
@@ -637,17 +636,18 @@ def sensitivity(
         if parse_override(o)[0] in problem:
             raise SweepSpecError(f"--set {o}: {parse_override(o)[0]} is also a --key; give it in one place")
     label, base, sha = read_scene(scene)
-    load_scenario(dict(base), list(overrides))  # the fixed overrides alone
+    parsed = [parse_feature(f) for f in specs]
+    fixed = load_scenario(dict(base), list(overrides))  # the fixed overrides alone
+    check_feature_windows(fixed, parsed)  # a window the run cannot hold, before the sample is drawn
     for k, (lo, hi) in problem.items():
         for v in (lo, hi):
             try:
                 load_scenario(dict(base), [*overrides, f"{k}={v!r}"])
             except ScenarioError as exc:
                 raise SweepSpecError(f"--key {k}={lo!r}:{hi!r}: at {k} = {v!r}: {exc}") from None
-    parsed = [parse_feature(f) for f in specs]
 
     def check(X: np.ndarray) -> None:  # after the options are checked, before anything is written
-        _check_rows(problem, base, overrides, X)
+        _check_rows(problem, base, overrides, X, parsed)
         check_feature_signals(base, overrides, parsed)
 
     return analyse_model(
@@ -672,6 +672,29 @@ def sensitivity(
 
 PROBE_S = 0.002
 """Simulated time of the probe run that finds the signals a scene records (a few hundredths of a second)."""
+
+
+def check_feature_windows(scenario, specs, where: str = "", option: str = "--feature") -> None:
+    """Every feature's window exists in a run of ``scenario``: its operating ``period``, its
+    ``from_s``..``to_s`` or ``fraction`` holding 2 samples or more of the run's output grid. Needs no run:
+    SweepSpecError naming the feature (given by ``option``), the run's length and its operating periods
+    (``where``: which scenario)."""
+    from gearbody.analysis.features import WINDOW_OPTIONS, FeatureError, Record, operating_periods_s
+    from gearbody.model.budget import output_samples
+
+    op, rate = scenario.operation, scenario.solver.output_rate_hz
+    t = np.arange(output_samples(scenario)) / rate
+    edges = operating_periods_s(t[0], t[-1], [*op.speed_profile.time_s, *op.load_profile.time_s])
+    grid = Record(time_s=t, signals={}, period_boundaries_s=edges)
+    for spec in specs:
+        try:
+            grid.window({k: v for k, v in spec.options.items() if k in WINDOW_OPTIONS})
+        except FeatureError as exc:
+            bounds = ", ".join(f"{e:g}" for e in edges)
+            raise SweepSpecError(
+                f"{option} {spec}: {exc} in a run of operation.t_end_s = {op.t_end_s:g} s{where} ({t.size} "
+                f"samples; operating periods 1..{len(edges) - 1}, boundaries {bounds} s); nothing was run"
+            ) from None
 
 
 def check_feature_signals(base: Mapping[str, Any], overrides: Sequence[str], specs) -> None:
@@ -701,15 +724,17 @@ def check_feature_signals(base: Mapping[str, Any], overrides: Sequence[str], spe
                 )
 
 
-def _check_rows(problem, base, overrides, X: np.ndarray) -> None:
-    """Every row's scenario valid (keys that are valid alone may be refused together)."""
+def _check_rows(problem, base, overrides, X: np.ndarray, specs=()) -> None:
+    """Every row's scenario valid (keys that are valid alone may be refused together), and every
+    feature's window in it (:func:`check_feature_windows`)."""
     from gearbody.model import ScenarioError, load_scenario
 
     for r, x in enumerate(X):
         row = [f"{k}={float(v)!r}" for k, v in zip(problem, x, strict=True)]
         try:
-            load_scenario(dict(base), [*overrides, *row])
+            scenario = load_scenario(dict(base), [*overrides, *row])
         except ScenarioError as exc:
             raise SweepSpecError(
                 f"sample row {r} ({', '.join(row)}) is not a valid scenario: {exc}"
             ) from None
+        check_feature_windows(scenario, specs, f" (sample row {r}: {', '.join(row)})")

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from gearbody.model import Scenario, ScenarioError, parse_override
-from gearbody.model.io import load_scenario, override_label, read_toml
+from gearbody.model.io import load_scenario, override_label, parse_scenario_bytes, read_scenario_bytes
 
 from .parse import (
     MAX_CASES,
@@ -137,13 +137,14 @@ class Study:
                 by = seen.get(key, "--seeds")
                 raise SweepSpecError(f"--set {o}: {key} is also varied by {by}; give it in one place")
         label, path = _resolve_scene(scene)
-        base = read_toml(path)
+        data = read_scenario_bytes(path)  # a regular file within the size limit, read once
+        base = parse_scenario_bytes(data, path)
         if isinstance(base.get("meta"), dict):  # the cases of a study carry the scene's name
             base["meta"].setdefault("name", path.stem)
         return cls(
             scene=label,
             base=base,
-            scene_sha256=hashlib.sha256(path.read_bytes()).hexdigest(),
+            scene_sha256=hashlib.sha256(data).hexdigest(),
             base_overrides=base_overrides,
             vary=axes,
             random=rand,
@@ -277,7 +278,7 @@ def _vary_axes(
         texts = tuple(toml_literal(v) for v in values)
         if len(set(texts)) != len(texts):
             raise SweepSpecError(f"{label}: repeated value in {values!r}")
-        axes.append(Axis(key, texts, tuple(toml_value(t) for t in texts), label))
+        axes.append(Axis(key, texts, tuple(toml_value(t, label) for t in texts), label))
     return tuple(axes)
 
 
