@@ -141,7 +141,9 @@ def atomic_write(path: str | Path, write: Callable[[Path], Any]) -> Path:
 
 
 def write_text(path: str | Path, text: str) -> Path:
-    """``text`` to ``path`` atomically (:func:`atomic_write`)."""
+    """``text`` to ``path`` atomically (:func:`atomic_write`), as UTF-8: a path quoted in it that is not
+    UTF-8 (its bytes kept as surrogates) gets U+FFFD in their place."""
+    text = text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
     return atomic_write(path, lambda p: p.write_text(text))
 
 

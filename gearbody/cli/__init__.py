@@ -82,11 +82,22 @@ def _sigterm_stops() -> Iterator[list[int]]:
         signal.signal(signal.SIGTERM, previous)
 
 
+def _printable_paths() -> None:
+    """A file name that is not UTF-8 (its bytes kept as surrogates by Python) is printed with backslash
+    escapes: under a UTF-8 locale stdout would raise UnicodeEncodeError on it, after the work was done."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError):  # not a text stream of its own (a test's capture, closed)
+            pass
+
+
 def main(argv: list[str] | None = None) -> int:
     from gearbody.errors import GearbodyError, ScenarioError, SimulationError
 
     from .common import check_options
 
+    _printable_paths()
     args = _parser().parse_args(argv)
     with _sigterm_stops() as terminated:
         try:

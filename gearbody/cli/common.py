@@ -138,15 +138,18 @@ def check_out(path: Path, option: str = "--out") -> Path:
 
     path = Path(path)
     shown = f"{option} {path}"
-    if path.is_symlink() and not path.exists():
-        raise InputError(f"{shown}: a broken symbolic link, not a folder")
-    if path.exists() and not path.is_dir():
-        raise InputError(f"{shown}: is a file, not a folder")
-    base = path
-    while not base.exists() and not base.is_symlink() and base.parent != base:
-        base = base.parent
-    if not base.is_dir():
-        raise InputError(f"{shown}: {base} is a file, not a folder")
+    try:  # a name the system cannot even look up (too long) is refused with its reason
+        if path.is_symlink() and not path.exists():
+            raise InputError(f"{shown}: a broken symbolic link, not a folder")
+        if path.exists() and not path.is_dir():
+            raise InputError(f"{shown}: is a file, not a folder")
+        base = path
+        while not base.exists() and not base.is_symlink() and base.parent != base:
+            base = base.parent
+        if not base.is_dir():
+            raise InputError(f"{shown}: {base} is a file, not a folder")
+    except OSError as exc:
+        raise InputError(f"{shown}: cannot be used: {exc.strerror or exc}") from None
     try:
         os.rmdir(tempfile.mkdtemp(prefix=".gearbody-probe-", dir=base))
     except OSError as exc:

@@ -48,10 +48,11 @@ def register(sub) -> argparse.ArgumentParser:
 
 
 def _scene_file(scene: str) -> Path:
+    from gearbody.model.io import names_a_file
     from gearbody.model.scenes import scene_path
 
     path = Path(scene)
-    return path if path.suffix or path.exists() else scene_path(scene)
+    return path if path.suffix or names_a_file(path) else scene_path(scene)
 
 
 def execute(args) -> int:
@@ -86,6 +87,8 @@ def execute(args) -> int:
     document = commented_toml(
         scenario, given=given, overridden=list(origins), intro=intro, scene_notes=header_comment(text)
     )
+    # file names that are not UTF-8 (their bytes kept as surrogates) are quoted with U+FFFD: the file is UTF-8
+    document = document.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
     if str(out) == "-":
         sys.stdout.write(document)
         return EXIT_OK

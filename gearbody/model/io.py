@@ -52,6 +52,17 @@ def _not_regular(path: Path, mode: int, what: str) -> ScenarioError:
     return ScenarioError(f"{path}: {kind}, not a scenario file ({what}; only regular files are read)")
 
 
+def names_a_file(path: str | Path) -> bool:
+    """Whether ``path`` is to be read as a file rather than taken as a scene name: something is there (a
+    broken or looping symbolic link included), or its name cannot even be looked up (too long): the
+    reader then refuses it in one line naming the reason, where ``Path.exists`` would raise."""
+    path = Path(path)
+    try:
+        return path.exists() or path.is_symlink()
+    except OSError:
+        return True
+
+
 def read_scenario_bytes(path: str | Path) -> bytes:
     """The bytes of a scenario file: a regular file of at most MAX_SCENARIO_BYTES, else a one-line
     ScenarioError naming the file (missing, unreadable, a folder, a FIFO or device, too large).
@@ -155,7 +166,7 @@ def parse_scenario_bytes(data: bytes, path: str | Path) -> dict[str, Any]:
         ) from None
     if "\x00" in text:
         raise ScenarioError(f"{path}: a binary file (contains NUL bytes), not a scenario file ({what})")
-    return _parse_toml(text, str(path))
+    return _parse_toml(text.removeprefix("\ufeff"), str(path))  # a byte-order mark (Windows editors)
 
 
 def override_label(text: str, limit: int = 200) -> str:
@@ -297,9 +308,12 @@ def load_scenario(
             raise _too_deep(name)
     else:
         path = Path(source)
-        if not path.suffix and not path.exists():
+        if not path.suffix and not names_a_file(path):
             path = scene_path(str(source))
-        data, name, stem = read_toml(path), str(path), path.stem
+        # a file name that is not UTF-8 (bytes kept as surrogates) names the scenario with U+FFFD in
+        # their place: meta.name is written into scenario.toml and summary.json, which are UTF-8
+        stem = path.stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+        data, name = read_toml(path), str(path)
     data, aliases = canonical_form(data, name)
     data, more, origins = apply_overrides(data, overrides, labels)
     meta = data.setdefault("meta", {})
@@ -316,5 +330,7 @@ def scenario_to_dict(scenario: Scenario) -> dict[str, Any]:
 def dump_scenario(scenario: Scenario, path: str | Path) -> Path:
     """Write the resolved scenario as TOML; loading that file gives an equal scenario."""
     path = Path(path)
-    path.write_text(tomli_w.dumps(scenario_to_dict(scenario)))
+    text = tomli_w.dumps(scenario_to_dict(scenario))
+    # a path quoted in it that is not UTF-8 (bytes kept as surrogates) gets U+FFFD: the file is UTF-8
+    path.write_text(text.encode("utf-8", "surrogateescape").decode("utf-8", "replace"))
     return path

@@ -247,7 +247,7 @@ def _convert_variant(value: Any, kinds: list[type], ctx: _Ctx) -> Any:
         ctx.fail(value, f"must be a table of {_type_name(kinds[0])} keys")
     by_kind = {getattr(k, "KIND", _type_name(k)): k for k in kinds}
     kind = value.get("type", getattr(kinds[0], "KIND", None))
-    if kind not in by_kind:
+    if not isinstance(kind, str) or kind not in by_kind:  # (an array or a table is no kind: unhashable)
         meta = {"choices": tuple(by_kind)}
         _convert(kind, str, ctx.child("type"), meta)  # names the key, the value and the choices
     cls = by_kind[kind]

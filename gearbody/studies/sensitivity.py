@@ -29,6 +29,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 import re
 import sys
 import time
@@ -581,13 +582,13 @@ def scene_features(
 def read_scene(scene: str | Path) -> tuple[str, dict[str, Any], str]:
     """(label stored in the spec, TOML data, sha256 of the file) of a scene name or TOML path."""
     from gearbody.model import scene_path
-    from gearbody.model.io import parse_scenario_bytes, read_scenario_bytes
+    from gearbody.model.io import names_a_file, parse_scenario_bytes, read_scenario_bytes
 
     path = Path(scene)
-    if not path.suffix and not path.exists():
+    if not path.suffix and not names_a_file(path):
         label, path = str(scene), scene_path(str(scene))
-    else:
-        label = str(path.resolve())
+    else:  # realpath: a symbolic-link loop is the reader's one-line refusal below, not a RuntimeError
+        label = os.path.realpath(path)
     data = read_scenario_bytes(path)  # refuses a missing file, a folder, a FIFO, a device, a huge file
     base = parse_scenario_bytes(data, path)
     if isinstance(base.get("meta"), dict):

@@ -7,13 +7,20 @@ from __future__ import annotations
 import hashlib
 import itertools
 import math
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from gearbody.model import Scenario, ScenarioError, parse_override
-from gearbody.model.io import load_scenario, override_label, parse_scenario_bytes, read_scenario_bytes
+from gearbody.model.io import (
+    load_scenario,
+    names_a_file,
+    override_label,
+    parse_scenario_bytes,
+    read_scenario_bytes,
+)
 
 from .parse import (
     MAX_CASES,
@@ -50,11 +57,11 @@ def _resolve_scene(scene: str | Path) -> tuple[str, Path]:
     from gearbody.model.scenes import scene_path
 
     path = Path(scene)
-    if not path.suffix and not path.exists():
+    if not path.suffix and not names_a_file(path):
         return str(scene), scene_path(str(scene))
-    if not path.exists():
-        raise ScenarioError(f"{path}: no such scenario file")  # a folder or binary: read_toml says so
-    return str(path.resolve()), path
+    if not names_a_file(path):  # a folder, binary, a link loop, a name too long: read_toml says so
+        raise ScenarioError(f"{path}: no such scenario file")
+    return os.path.realpath(path), path
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,94 @@
+"""What the fuzzers of issue 26 found (tests/test_fuzz_cli.py), each refused in one line before anything
+runs (exit 2) or handled: the command lines as the fuzzer drew them, minimised."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from gearbody.cli import main
+
+KEY = "condition.friction_coefficient"
+STUDY = ["--t-end", "0.003", "--workers", "1", "--quiet"]
+
+
+def _one_line(capsys, argv: list[str], code: int = 2) -> str:
+    assert main(argv) == code
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "Traceback" not in err[0], err
+    return err[0]
+
+
+def test_a_symlink_loop_as_the_scene_is_refused_by_every_study(tmp_path, capsys):
+    """On main sensitivity and calibrate raised RuntimeError('Symlink loop') from Path.resolve, and sweep
+    called the loop 'no such scenario file'."""
+    loop = tmp_path / "loop.toml"
+    (tmp_path / "other.toml").symlink_to(loop)
+    loop.symlink_to(tmp_path / "other.toml")
+    for argv in (
+        ["sweep", str(loop), "--vary", f"{KEY}=0,0.05"],
+        ["sensitivity", str(loop), "--key", f"{KEY}=0:0.05", "--feature", "kd_max", "--samples", "2"],
+        ["calibrate", str(loop), "--param", f"{KEY}=0:0.05", "--target", "kd_max", "1.5", "0.5"],
+    ):
+        line = _one_line(capsys, [*argv, *STUDY, "--out", str(tmp_path / "study")])
+        assert f"{loop}: cannot read the scenario file: Too many levels of symbolic links" in line
+
+
+def test_names_too_long_for_the_system_are_refused_as_input(tmp_path, capsys, monkeypatch):
+    """On main 'File name too long' escaped as exit 1 ('failed', as for a full disk) from Path.exists."""
+    monkeypatch.chdir(tmp_path)
+    long = "y" * 300
+    line = _one_line(capsys, ["run", "two-wheel", "--t-end", "0.003", "--no-plots", "--out", long])
+    assert line.endswith(f"--out {long}: cannot be used: File name too long")
+    line = _one_line(capsys, ["sweep", f"{long}.toml", "--vary", f"{KEY}=0,0.05", *STUDY, "--out", "s"])
+    assert line.endswith(f"{long}.toml: cannot read the scenario file: File name too long")
+    line = _one_line(capsys, ["run", long, "--t-end", "0.003", "--no-plots", "--out", "r"])
+    assert line.endswith(f"{long}: cannot read the scenario file: File name too long")
+    assert sorted(os.listdir(tmp_path)) == []
+
+
+def test_a_scenario_file_whose_name_is_not_utf8_runs_and_writes_utf8(tmp_path, capsys, monkeypatch):
+    """On main: UnicodeEncodeError writing scenario.toml (the scenario named after the file)."""
+    from gearbody.model import load_scenario
+    from gearbody.model.scenes import scene_path
+
+    monkeypatch.chdir(tmp_path)
+    name = os.fsdecode(b"drive-\xff.toml")  # as Python gives a file name that is not UTF-8
+    (tmp_path / name).write_bytes(scene_path("two-wheel").read_bytes())
+    assert main(["run", name, "--t-end", "0.003", "--no-plots", "--quiet", "--out", "run"]) == 0
+    written = (tmp_path / "run" / "scenario.toml").read_bytes().decode("utf-8")  # UTF-8, or this raises
+    assert 'name = "drive-\ufffd"' in written
+    assert load_scenario(tmp_path / "run" / "scenario.toml").meta.name == "drive-\ufffd"
+
+
+def test_outputs_under_a_name_that_is_not_utf8_are_written_as_utf8(tmp_path, capsys, monkeypatch):
+    """On main: UnicodeEncodeError writing calibrated.toml and new's file, which quote their paths."""
+    monkeypatch.chdir(tmp_path)
+    folder = os.fsdecode(b"out-\xfe")
+    assert main(["new", "two-wheel", "--out", f"{folder}.toml"]) == 0
+    assert "\ufffd" in (tmp_path / f"{folder}.toml").read_bytes().decode("utf-8")
+    argv = ["calibrate", "two-wheel", "--param", f"{KEY}=0:0.05", "--target", "kd_max", "1.5", "0.5"]
+    assert main([*argv, "--budget", "2", "--polish-evaluations", "0", *STUDY, "--out", folder]) == 0
+    assert "\ufffd" in (tmp_path / folder / "calibrated.toml").read_bytes().decode("utf-8")
+
+
+def test_a_scenario_file_with_a_byte_order_mark_is_read(tmp_path, capsys):
+    """Windows editors write UTF-8 with a byte-order mark; on main: 'Invalid statement (at line 1,
+    column 1)'."""
+    from gearbody.model import load_scenario
+    from gearbody.model.scenes import scene_path
+
+    path, plain = tmp_path / "two-wheel.toml", scene_path("two-wheel")
+    path.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes())
+    assert load_scenario(path) == load_scenario(plain)
+
+
+@pytest.mark.parametrize("value", ["[]", "{}", "1", "true"])
+def test_a_stage_type_that_is_no_string_is_refused_naming_it(value):
+    """Drawn by the document fuzzer with its draws fixed; on main: TypeError 'unhashable type: list'."""
+    from gearbody.errors import InputError
+    from gearbody.model import load_scenario
+
+    with pytest.raises(InputError, match=r"design\.stages\.2\.type = .*: must be a string"):
+        load_scenario("planetary-conveyor", [f"design.stages.2.type={value}"])
