@@ -20,6 +20,43 @@ def _one_line(capsys, argv: list[str], code: int = 2) -> str:
     return err[0]
 
 
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (  # on main: SALib's ValueError 'array is too big'
+            ["sensitivity", "two-wheel", "--key", f"{KEY}=0:0.05", "--feature", "kd_max", "--samples", "2"]
+            + ["--levels", str(2**63)],
+            f"--levels must be even (a grid jump of levels/(2 (levels-1))) and <= 1000, got {2**63}",
+        ),
+        (  # on main: Sobol's ValueError 'Maximum allowed dimension exceeded', --force let it through
+            ["sensitivity", "two-wheel", "--key", f"{KEY}=0:0.05", "--feature", "kd_max", "--method", "sobol"]
+            + ["--samples", str(2**63), "--force"],
+            "above the most any analysis may have (100000, --force included); lower --samples",
+        ),
+        (  # on main: numpy's ValueError 'Seed must be between 0 and 2**32 - 1'
+            ["calibrate", "two-wheel", "--param", f"{KEY}=0:0.05", "--target", "kd_max", "1.5", "0.5"]
+            + ["--budget", "2", "--seed", str(2**64)],
+            f"--seed must be a whole number >= 0 and <= 4294967295, got {2**64}",
+        ),
+        (  # on main: MemoryError while listing 2**41 cases
+            ["sweep", "two-wheel", "--seeds", str(2**40), "--max-cases", str(2**63)],
+            f"--max-cases = {2**63}: at most 100000 (a study's cases are listed in memory before any runs)",
+        ),
+    ],
+)
+def test_counts_and_seeds_beyond_what_a_study_can_hold_are_refused(tmp_path, capsys, argv, expected):
+    out = tmp_path / "study"
+    line = _one_line(capsys, [*argv, *STUDY, "--out", str(out)])
+    assert expected in line
+    assert not out.exists()
+
+
+def test_the_largest_seed_a_calibration_takes_runs(tmp_path, capsys):
+    argv = ["calibrate", "two-wheel", "--param", f"{KEY}=0:0.05", "--target", "kd_max", "1.5", "0.5"]
+    argv += ["--budget", "2", "--polish-evaluations", "0", "--seed", str(2**32 - 1), *STUDY]
+    assert main([*argv, "--out", str(tmp_path / "cal")]) == 0
+
+
 def test_a_symlink_loop_as_the_scene_is_refused_by_every_study(tmp_path, capsys):
     """On main sensitivity and calibrate raised RuntimeError('Symlink loop') from Path.resolve, and sweep
     called the loop 'no such scenario file'."""

@@ -17,6 +17,7 @@ from ..errors import StudySpecError
 
 __all__ = [
     "MAX_CASES",
+    "MOST_CASES",
     "Axis",
     "Distribution",
     "RandomAxis",
@@ -38,6 +39,11 @@ MAX_CASES = 10_000
 """Most cases a study may have unless raised explicitly (``--max-cases``, ``max_cases=``): each case is
 a whole simulation (seconds of wall time), and a larger grid is far more likely a typing slip (an extra
 zero in a count) than a plan. Checked, like a range's count, before any value list is made."""
+
+MOST_CASES = 100_000
+"""Most cases (simulations) a study may have at all, whatever ``--max-cases`` or ``--force`` allow: its
+case list or sample matrix is made in memory before anything runs (100,000 cases: ~0.1 GB; a count of
+2**40 ran out of memory), and 100,000 simulations take hours even at 0.1 s each."""
 
 SweepSpecError = StudySpecError
 """Invalid study input (syntax, conflicting options, a spec that differs from the one on disk); the

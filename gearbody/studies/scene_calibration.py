@@ -56,6 +56,9 @@ __all__ = ["MAX_EVALUATIONS", "SceneCalibration", "calibrate_scene", "parse_para
 
 MAX_EVALUATIONS = 2000
 """Largest budget + polish evaluations of one calibration (each a simulation per case) unless forced."""
+MAX_SEED = 2**32 - 1
+"""Largest optimiser seed (``--seed``): the optimiser's random state takes 32 bits (2**64 raised numpy's
+'Seed must be between 0 and 2**32 - 1')."""
 
 
 @dataclass
@@ -177,6 +180,8 @@ def calibrate_scene(
             raise SweepSpecError(
                 f"--{n.replace('_', '-')} must be a whole number >= {1 if n == 'budget' else 0}, got {v!r}"
             )
+    if seed > MAX_SEED:
+        raise SweepSpecError(f"--seed must be a whole number >= 0 and <= {MAX_SEED}, got {seed!r}")
     check_options(workers, scheduler)
     if batch is None:
         batch = 2 if workers is None else max(1, workers)

@@ -45,7 +45,7 @@ from gearbody.folders import claim, output_error
 from gearbody.version import __version__
 
 from .executors import check_options, failure, run_jobs
-from .parse import SweepSpecError, check_key
+from .parse import MOST_CASES, SweepSpecError, check_key
 from .store import read_json, write_json, write_text
 
 __all__ = [
@@ -69,7 +69,11 @@ __all__ = [
 FORMAT = "gearbody-sensitivity/1"
 METHODS = ("morris", "sobol")
 MAX_RUNS = 2000
-"""Default bound on the simulations of one :func:`sensitivity` (``force`` / ``--force`` lifts it)."""
+"""Default bound on the simulations of one :func:`sensitivity` (``force`` / ``--force`` lifts it, up to
+:data:`gearbody.studies.parse.MOST_CASES`: the sample matrix is made before anything runs)."""
+MAX_LEVELS = 1000
+"""Most Morris grid levels (``--levels``; 4-10 are usual): SALib allocates per level, and 2**63 levels
+raised numpy's 'array is too big'."""
 INDEX_NAMES = {
     "morris": ("mu_star", "mu_star_conf", "sigma", "mu"),
     "sobol": ("S1", "S1_conf", "ST", "ST_conf"),
@@ -421,9 +425,10 @@ def analyse_model(
     if method == "morris":
         samples = _whole(samples, "--samples (Morris trajectories)", 2)
         levels = _whole(levels, "--levels", 2)
-        if levels % 2:
+        if levels % 2 or levels > MAX_LEVELS:
             raise SweepSpecError(
-                f"--levels must be even (a grid jump of levels/(2 (levels-1))), got {levels}"
+                f"--levels must be even (a grid jump of levels/(2 (levels-1))) and <= {MAX_LEVELS}, got "
+                f"{levels}"
             )
     else:
         samples = _whole(samples, "--samples (Sobol base sample)", 2)
@@ -436,6 +441,11 @@ def analyse_model(
     if not 0 < conf_level < 1:
         raise SweepSpecError(f"conf_level must be in (0, 1), got {conf_level!r}")
     n_rows = run_count(method, samples, len(problem), second_order)
+    if n_rows > MOST_CASES:  # even with --force: the sample matrix is made in memory first
+        raise SweepSpecError(
+            f"{method} with --samples {samples} over {len(problem)} keys is {n_rows} runs, above the most "
+            f"any analysis may have ({MOST_CASES}, --force included); lower --samples"
+        )
     if max_runs is not None and n_rows > max_runs and not force:
         raise SweepSpecError(
             f"{method} with --samples {samples} over {len(problem)} keys is {n_rows} runs, above the limit "

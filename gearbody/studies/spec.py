@@ -24,6 +24,7 @@ from gearbody.model.io import (
 
 from .parse import (
     MAX_CASES,
+    MOST_CASES,
     Axis,
     RandomAxis,
     SweepSpecError,
@@ -112,6 +113,11 @@ class Study:
         """
         if isinstance(max_cases, bool) or int(max_cases) != max_cases or max_cases < 1:
             raise SweepSpecError(f"--max-cases must be a whole number >= 1, got {max_cases!r}")
+        if max_cases > MOST_CASES:
+            raise SweepSpecError(
+                f"--max-cases = {max_cases}: at most {MOST_CASES} (a study's cases are listed in memory "
+                "before any runs)"
+            )
         max_cases = int(max_cases)
         axes = _vary_axes(vary, max_cases)
         rand = _random_axes(random)
