@@ -2,23 +2,23 @@
 shipped scene, either load into a Scenario or are refused with the documented input error
 (:class:`gearbody.errors.InputError`, exit code 2), never another exception.
 
-Deterministic (``derandomize=True``, no example database) and bounded: ``max_examples`` per scene and
-property, scaled by the environment variable ``GEARBODY_FUZZ_SCALE`` (default 1: ~10 s on two cores).
-With ``GEARBODY_FUZZ_REPORT=path`` the examples run per outcome are written there as JSON.
+Deterministic and bounded (tests/fuzzing.py: ``derandomize=True``, no example database, no constants
+mined from local modules, so the draws do not depend on the tests collected before): ``max_examples``
+per scene and property, scaled by the environment variable ``GEARBODY_FUZZ_SCALE`` (default 1: ~10 s on
+two cores). With ``GEARBODY_FUZZ_REPORT=path`` the examples run per outcome are merged into that JSON
+file. A failure prints the falsifying overrides or document (Hypothesis), shrunk.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import os
-from collections import Counter
-from pathlib import Path
 from typing import Any
 
 import pytest
 import tomli_w
-from hypothesis import HealthCheck, given, settings
+from fuzzing import Report, fuzz_settings, leaves, print_line
+from hypothesis import given
 from hypothesis import strategies as st
 
 from gearbody.errors import InputError
@@ -26,28 +26,15 @@ from gearbody.model import Scenario, load_scenario, scenario_to_dict
 from gearbody.model.io import read_toml
 from gearbody.model.scenes import list_scenes, scene_path
 
-SCALE = float(os.environ.get("GEARBODY_FUZZ_SCALE", "1"))
 SCENES = list_scenes()
-OUTCOMES: Counter[tuple[str, str]] = Counter()
-
-
-def fuzz_settings(examples: int):
-    return settings(
-        max_examples=max(1, round(examples * SCALE)),
-        deadline=None,
-        derandomize=True,
-        database=None,
-        suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much],
-    )
+REPORT = Report("inputs")
 
 
 @pytest.fixture(scope="module", autouse=True)
-def _report():
+def _report(request):
     yield
-    path = os.environ.get("GEARBODY_FUZZ_REPORT")
-    if path:
-        rows = [{"input": k, "outcome": o, "examples": n} for (k, o), n in sorted(OUTCOMES.items())]
-        Path(path).write_text(json.dumps(rows, indent=1) + "\n")
+    REPORT.write()
+    print_line(request, "\n" + REPORT.line())
 
 
 def outcome(kind: str, load) -> None:
@@ -56,10 +43,10 @@ def outcome(kind: str, load) -> None:
         sc = load()
     except InputError as exc:
         assert str(exc) and "Traceback" not in str(exc)
-        OUTCOMES[kind, type(exc).__name__] += 1
+        REPORT.add(kind, type(exc).__name__)
         return
     assert isinstance(sc, Scenario)
-    OUTCOMES[kind, "Scenario"] += 1
+    REPORT.add(kind, "Scenario")
 
 
 def _keys(data: Any, prefix: str = "") -> list[str]:
@@ -139,19 +126,7 @@ def key_strategy(scene: str):
     )
 
 
-def _leaves(data: Any, prefix: str = "") -> dict[str, Any]:
-    """Dotted key -> value of every number (not bool) in a nested dict."""
-    out = {}
-    items = data.items() if isinstance(data, dict) else ((str(i + 1), v) for i, v in enumerate(data))
-    for k, v in items:
-        if isinstance(v, (dict, list)):
-            out.update(_leaves(v, f"{prefix}{k}."))
-        elif isinstance(v, (int, float)) and not isinstance(v, bool):
-            out[f"{prefix}{k}"] = v
-    return out
-
-
-NUMBERS = {scene: _leaves(scenario_to_dict(load_scenario(scene))) for scene in SCENES}
+NUMBERS = {scene: leaves(scenario_to_dict(load_scenario(scene))) for scene in SCENES}
 FACTORS = [0, -1, 1e-300, 1e-12, 1e-6, 0.01, 0.5, 0.999, 1 + 1e-9, 1.5, 2, 10, 100, 1e6, 1e12, 1e300]
 
 
@@ -209,7 +184,7 @@ def _mutate(data: dict[str, Any], path: list[str], value: Any, delete: bool) -> 
 def document_strategy(scene: str):
     base = read_toml(scene_path(scene))
     keys = _keys(base)
-    numbers = _leaves(base)
+    numbers = leaves(base)
     near = st.builds(
         lambda k, f: (k, numbers[k] * f if isinstance(numbers[k], float) else round(numbers[k] * f), False),
         st.sampled_from(sorted(numbers)),
@@ -251,7 +226,7 @@ def test_random_toml_documents_load_or_are_refused_as_input_errors(scene, tmp_pa
             try:
                 text = tomli_w.dumps(content)
             except (TypeError, ValueError):  # not writable as TOML (e.g. a nested list of tables)
-                OUTCOMES["documents", "not writable as TOML"] += 1
+                REPORT.add("documents", "not writable as TOML")
                 return
             path.write_bytes(text.encode("utf-8", "surrogatepass"))  # lone surrogates: not UTF-8
         elif kind == "text":
