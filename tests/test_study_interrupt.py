@@ -249,6 +249,13 @@ def test_an_interrupted_and_worker_killed_study_resumes_to_the_uninterrupted_res
     # every case was recorded by exactly one run, and all match an uninterrupted study bit for bit
     runs = [set(first), set(second) - set(first) - {killed}, {killed}]
     assert sum(len(r) for r in runs) == 8 and set().union(*runs) == set(third)
+    _assert_uninterrupted(tmp_path, out, third)
+
+
+def _assert_uninterrupted(tmp_path: Path, out: Path, records: dict) -> None:
+    """Every case of ``records`` in ``out`` equals that of an uninterrupted serial study bit for bit
+    (wall-clock entries aside)."""
+    assert len(records) == 8 and {s for s, _ in records.values()} == {"ok"}
     ref = tmp_path / "ref"
     run_study(
         SCENE,
@@ -258,7 +265,7 @@ def test_an_interrupted_and_worker_killed_study_resumes_to_the_uninterrupted_res
         workers=1,
         progress=False,
     )
-    for case in sorted(third):
+    for case in sorted(records):
         with (
             np.load(out / "cases" / case / "result.npz") as a,
             np.load(ref / "cases" / case / "result.npz") as b,
@@ -358,3 +365,107 @@ def _running(pid: int) -> bool:
     except (FileNotFoundError, ProcessLookupError):
         return False
     return stat.rsplit(")", 1)[1].split()[0] != "Z"
+
+
+# --- no process outlives its study ------------------------------------------------------------------
+
+
+def _children(pid: int) -> set[int]:
+    """Pids of the live processes whose parent is ``pid`` (Linux /proc)."""
+    found = set()
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (FileNotFoundError, ProcessLookupError, IndexError):
+            continue
+        if int(fields[1]) == pid and fields[0] != "Z":
+            found.add(int(stat.parent.name))
+    return found
+
+
+def _gone_within(pids: set[int], timeout_s: float) -> set[int]:
+    """The pids still running after ``timeout_s`` (empty: all gone)."""
+    t0 = time.monotonic()
+    while any(map(_running, pids)) and time.monotonic() - t0 < timeout_s:
+        time.sleep(0.05)
+    return {p for p in pids if _running(p)}
+
+
+def _kill_all(pids):
+    for pid in pids:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers in Linux /proc")
+def test_a_study_killed_with_sigkill_takes_its_workers_with_it_and_resumes(tmp_path, started_by_nohup):
+    """kill -9 of a sweep's main process, while its pool workers simulate: the workers go within a few
+    seconds (they used to run on, then wait for work for ever); the same command then resumes the study
+    and ends as an uninterrupted one."""
+    out = tmp_path / "study"
+    proc = _sweep(out, "--workers", "2", "--quiet")
+    running = out / ".running"
+    _wait(lambda: len(_records(out)) >= 1 and running.exists() and list(running.glob("*")), proc)
+    workers = _children(proc.pid)
+    try:
+        assert len(workers) == 2, workers
+        os.kill(proc.pid, signal.SIGKILL)  # the main process only: nothing can clean up after it
+        assert proc.wait(timeout=30) == -signal.SIGKILL  # (not communicate: live workers hold its pipes)
+        assert not _gone_within(workers, 5.0)
+        proc.stdout.close(), proc.stderr.close()
+        done = len(_records(out))
+        assert 1 <= done < 8
+    finally:
+        _kill_all(workers)
+    proc = _sweep(out, "--workers", "2")
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    assert "cases already done" in err and "Traceback" not in err
+    _assert_uninterrupted(tmp_path, out, _records(out))
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers in Linux /proc")
+def test_without_the_kernels_death_signal_workers_still_follow_their_parent(tmp_path):
+    """The fallback where PR_SET_PDEATHSIG is missing (other platforms): a thread in each worker polls
+    its parent. Idle and busy workers of a pool whose parent is killed with SIGKILL are gone within a few
+    polls."""
+    script = tmp_path / "pool.py"
+    script.write_text(
+        "import os, sys, time\n"
+        "from concurrent.futures import ProcessPoolExecutor\n"
+        "from gearbody.studies import executors\n"
+        "pool = ProcessPoolExecutor(3, initializer=executors._worker_init, initargs=(os.getpid(), False))\n"
+        "busy = [pool.submit(time.sleep, 600) for _ in range(2)]\n"  # 2 busy, 1 idle
+        "print(' '.join(str(p) for p in pool._processes), flush=True)\n"
+        "time.sleep(600)\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, str(script)],
+        stdout=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
+    workers = {int(p) for p in proc.stdout.readline().split()}
+    try:
+        assert len(workers) == 3 and workers == _children(proc.pid)
+        time.sleep(0.2)  # every worker's initializer has run
+        proc.kill()
+        proc.wait(timeout=30)
+        assert not _gone_within(workers, 5 * executors.PARENT_POLL_S + 2.0)
+    finally:
+        _kill_all(workers)
+
+
+def test_a_worker_whose_parent_is_gone_before_it_starts_stops_at_once():
+    """The parent can die between the fork and the worker's initializer: the worker notices then."""
+    pid = os.fork()
+    if pid == 0:  # the "worker": its parent pid is not the one it was started for
+        try:
+            executors._worker_init(os.getppid() + 1_000_000)
+            time.sleep(30)
+        finally:
+            os._exit(0)
+    _, status = os.waitpid(pid, 0)
+    assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM
