@@ -36,6 +36,7 @@ import uuid
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -115,6 +116,45 @@ def _watch_parent(parent_pid: int, poll_s: float = PARENT_POLL_S) -> threading.T
     return thread
 
 
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+"""The signals that stop a study (Ctrl-C, and SIGTERM from the command line)."""
+
+
+@contextmanager
+def _stop_signals_held() -> Iterator[None]:
+    """Hold Ctrl-C and SIGTERM for the block and deliver one that arrived meanwhile when it ends.
+
+    Around a fork: Python runs the fork's hooks in the parent (logging's lock release), and a
+    KeyboardInterrupt raised in one of them is printed and lost, so the study would run on to its end;
+    raised between the forks and the pool's start it would leave the forked workers waiting for work
+    for ever. So a Python handler of either signal is replaced by one that notes the signal (it runs in
+    the main thread whichever thread the signal reached), and this thread blocks both: a signal noted
+    or pending is handled when the block ends, by the handler it was meant for. A forked child
+    inherits the blocked mask, so that a SIGTERM sent to it before :func:`_worker_init` releases the
+    mask stays pending instead of running the parent's handler."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    noted: list[int] = []
+    handlers = {s: signal.getsignal(s) for s in STOP_SIGNALS}
+    for s, handler in handlers.items():
+        if callable(handler):  # SIG_DFL and SIG_IGN run no Python code: nothing to lose
+            signal.signal(s, lambda signum, frame: noted.append(signum))
+    mask = (
+        signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS) if hasattr(signal, "pthread_sigmask") else None
+    )
+    try:
+        yield
+    finally:
+        for s, handler in handlers.items():
+            if callable(handler):
+                signal.signal(s, handler)
+        if mask is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)  # a pending one is handled here
+        if noted:
+            handlers[noted[0]](noted[0], None)
+
+
 def _worker_init(parent_pid: int, death_signal: bool = True) -> None:
     """Pool worker initializer. Ctrl-C reaches the whole process group and the parent stops the workers,
     so a worker ignores SIGINT; SIGTERM (how the parent stops them) gets its default action back, which a
@@ -126,6 +166,8 @@ def _worker_init(parent_pid: int, death_signal: bool = True) -> None:
     created and fed by the thread that iterates :func:`run_pool`, which outlives its workers."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "pthread_sigmask"):  # forked while the parent held them (_stop_signals_held)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
     if not (death_signal and _parent_death_signal()):
         _watch_parent(parent_pid)
     if os.getppid() != parent_pid:  # the parent died before the death signal was armed
@@ -174,9 +216,10 @@ def run_pool(
             processes: list = []
             broken = done = False
             try:
-                for jid, args in todo.items():
-                    futures[pool.submit(_marked, str(marks), task, jid, args)] = jid
-                processes = list(getattr(pool, "_processes", {}).values())  # fork: all started by now
+                with _stop_signals_held():  # the workers are forked in submit
+                    for jid, args in todo.items():
+                        futures[pool.submit(_marked, str(marks), task, jid, args)] = jid
+                    processes = list(getattr(pool, "_processes", {}).values())  # fork: all started by now
                 for fut in as_completed(futures):
                     try:
                         outcome = fut.result()
@@ -190,6 +233,7 @@ def run_pool(
                 done = True
             finally:
                 if not done:  # interrupted, closed early or broken: stop every worker now
+                    processes = processes or list(getattr(pool, "_processes", {}).values())
                     for p in processes:
                         p.terminate()
                 pool.shutdown(wait=True, cancel_futures=True)

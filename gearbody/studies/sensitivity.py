@@ -473,7 +473,14 @@ def analyse_model(
     jobs = [
         (jid, (model, c, [Xl[r] for r in c], keys_t, outputs, tuple(model_args))) for jid, c in by_id.items()
     ]
-    _run(jobs, by_id, out, workers, scheduler, progress)
+    try:
+        _run(jobs, by_id, out, workers, scheduler, progress)
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM: the rows written so far stay recorded
+        done = sum(1 for r in range(n_rows) if r in _recorded(out))
+        raise KeyboardInterrupt(
+            f"interrupted: {done} of {n_rows} runs recorded in {out / 'evaluations'}; rerun the same "
+            "command to resume"
+        ) from None
 
     recorded = _recorded(out)
     failed = [r for r in range(n_rows) if not recorded.get(r, {}).get("ok")]
