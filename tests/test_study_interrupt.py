@@ -509,6 +509,44 @@ def test_a_worker_whose_parent_is_gone_before_it_starts_stops_at_once():
     assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM
 
 
+@pytest.mark.slow
+def test_a_dask_study_killed_with_sigkill_leaves_no_work_on_the_cluster(tmp_path, started_by_nohup):
+    """Dask workers belong to their cluster and stay; the study's tasks do not: the scheduler forgets them
+    once the killed study's connection closes, and a task already running ends with its case."""
+    from dask.distributed import Client, LocalCluster
+
+    with (
+        LocalCluster(
+            n_workers=2, processes=True, threads_per_worker=1, host="127.0.0.1", dashboard_address=":0"
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+
+        def tasks() -> int:
+            return client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks))
+
+        def executing() -> int:
+            return sum(client.run(lambda dask_worker: dask_worker.state.executing_count).values())
+
+        out = tmp_path / "study"
+        proc = _sweep(out, "--scheduler", cluster.scheduler_address, "--quiet", t_end="1.0")
+        try:
+            _wait(lambda: tasks() == 8 and executing() == 2, proc)
+            os.kill(proc.pid, signal.SIGKILL)
+            assert proc.wait(timeout=30) == -signal.SIGKILL
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+            proc.communicate()
+        t0 = time.monotonic()
+        while tasks() and time.monotonic() - t0 < 10:
+            time.sleep(0.1)
+        assert tasks() == 0
+        while executing() and time.monotonic() - t0 < 60:  # the running cases end (~1 s each)
+            time.sleep(0.2)
+        assert executing() == 0 and len(client.scheduler_info()["workers"]) == 2
+
+
 STEADY_SET = [
     "--set", 'operation.initial_state="steady"',
     "--set", "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
