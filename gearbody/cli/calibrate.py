@@ -12,6 +12,7 @@ from .common import (
     add_executor,
     add_out,
     add_set,
+    add_wall_limit,
     check_out,
     number,
     scenario_overrides,
@@ -106,6 +107,7 @@ def register(sub) -> argparse.ArgumentParser:
     add_executor(ca)
     ca.add_argument("--force", action="store_true", help="allow more evaluations than the limit (2000)")
     ca.add_argument("--quiet", action="store_true", help="no progress and no table")
+    add_wall_limit(ca, "a calibration whose runs still to do are")
     add_out(ca, "output folder of the calibration", required=True)
     ca.set_defaults(handler=execute)
     return ca
@@ -157,6 +159,7 @@ def execute(args) -> int:
             seed=args.seed,
             force=args.force,
             progress=not args.quiet,
+            max_wall_minutes=args.max_wall_minutes,
         )
     except (SweepSpecError, ImportError) as exc:
         return usage_error("calibrate", str(exc))

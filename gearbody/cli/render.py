@@ -12,7 +12,9 @@ from .common import (
     EXIT_OK,
     add_out,
     add_set,
+    add_wall_limit,
     check_out,
+    check_wall_time,
     default_out,
     load,
     number,
@@ -119,6 +121,7 @@ def register(sub) -> argparse.ArgumentParser:
     )
     rd.add_argument("--interactive", action="store_true", help="replay in Exudyn's viewer (needs a display)")
     rd.add_argument("--quiet", action="store_true", help="no progress display")
+    add_wall_limit(rd, "a simulation (SCENE without --result or --kinematic)")
     rd.set_defaults(handler=execute)
     return rd
 
@@ -173,6 +176,7 @@ def execute(args) -> int:
         else:
             from gearbody.engine import simulate
 
+            check_wall_time(scenario, args)
             if not args.quiet:
                 print(f"simulating {args.scene} ({scenario.operation.t_end_s:g} s) ...")
             result = simulate(scenario, progress=not args.quiet)

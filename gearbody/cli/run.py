@@ -11,7 +11,9 @@ from .common import (
     EXIT_OK,
     add_out,
     add_set,
+    add_wall_limit,
     check_out,
+    check_wall_time,
     default_out,
     load,
     number,
@@ -56,6 +58,7 @@ def register(sub) -> argparse.ArgumentParser:
         help="also write DIR/report.html: summary, labelled spectrum, folded K_d, TSA and indicators",
     )
     run.add_argument("--quiet", action="store_true", help="no progress display and no summary on screen")
+    add_wall_limit(run, "a run")
     run.set_defaults(handler=execute)
     return run
 
@@ -75,6 +78,7 @@ def execute(args) -> int:
     from gearbody.model import dump_scenario
 
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
+    check_wall_time(scenario, args)
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     result = simulate(scenario, progress=not args.quiet)

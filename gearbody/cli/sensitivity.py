@@ -11,6 +11,7 @@ from .common import (
     add_executor,
     add_out,
     add_set,
+    add_wall_limit,
     check_out,
     number,
     scenario_overrides,
@@ -84,6 +85,7 @@ def register(sub) -> argparse.ArgumentParser:
         help="Morris only: compute the indices without the trajectories holding failed runs",
     )
     se.add_argument("--quiet", action="store_true", help="no progress bar and no table")
+    add_wall_limit(se, "an analysis whose runs still to do are")
     add_out(se, "output folder of the analysis", required=True)
     se.set_defaults(handler=execute)
     return se
@@ -113,6 +115,7 @@ def execute(args) -> int:
             retry_failed=args.retry_failed,
             exclude_failed=args.exclude_failed,
             progress=not args.quiet,
+            max_wall_minutes=args.max_wall_minutes,
         )
     except (SweepSpecError, FeatureError, ImportError) as exc:
         return usage_error("sensitivity", str(exc))

@@ -11,6 +11,7 @@ from .common import (
     add_executor,
     add_out,
     add_set,
+    add_wall_limit,
     check_out,
     number,
     scenario_overrides,
@@ -94,6 +95,7 @@ def register(sub) -> argparse.ArgumentParser:
     sw.add_argument("--no-results", action="store_true", help="do not keep result.npz (summaries only)")
     sw.add_argument("--retry-failed", action="store_true", help="on resume, rerun the cases that failed")
     sw.add_argument("--quiet", action="store_true", help="no progress bar and no table")
+    add_wall_limit(sw, "a study whose runs still to do are")
     add_out(sw, "output folder of the study", required=True)
     sw.set_defaults(handler=execute)
     return sw
@@ -122,6 +124,7 @@ def execute(args) -> int:
             plot_value=args.plot_value,
             plot_key=args.plot_key,
             max_cases=args.max_cases,
+            max_wall_minutes=args.max_wall_minutes,
         )
     except (SweepSpecError, ImportError) as exc:
         return usage_error("sweep", str(exc))

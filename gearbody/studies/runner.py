@@ -23,6 +23,7 @@ from .spec import MAX_CASES, Study
 from .store import case_state, prepare_out, write_case
 from .table import DEFAULT_PLOT_VALUE, StudyResult, check_plot_value, collect_rows, write_csv
 from .tasks import run_case
+from .wall import check_study_wall_time, run_estimates_s
 
 __all__ = ["StudyInterrupted", "run_study"]
 
@@ -53,6 +54,7 @@ def run_study(
     plot_value: str = DEFAULT_PLOT_VALUE,
     plot_key: str | None = None,
     max_cases: int = MAX_CASES,
+    max_wall_minutes: float | None = None,
 ) -> StudyResult:
     """Run a parameter study, resuming whatever ``out_dir`` already holds of it.
 
@@ -69,9 +71,12 @@ def run_study(
         plot_value: summary value to plot (default ``kd_max_final``).
         plot_key: varied key on the x axis (default: the first one).
         max_cases: most cases the study may have (default :data:`~gearbody.studies.spec.MAX_CASES`).
+        max_wall_minutes: refuse a study whose pending cases are estimated to take longer (default
+            None: no limit; the command line's --max-wall-minutes). With ``progress`` an estimate above
+            a minute is printed (:mod:`gearbody.studies.wall`).
     Raises:
-        SweepSpecError, ScenarioError: bad input (also more than ``max_cases`` cases), before anything
-            runs.
+        SweepSpecError, ScenarioError: bad input (also more than ``max_cases`` cases, or more than
+            ``max_wall_minutes`` of estimated wall time), before anything runs.
         StudyInterrupted: Ctrl-C (a KeyboardInterrupt); the finished cases are recorded.
         ImportError: ``scheduler`` given but dask.distributed is not installed.
     """
@@ -100,13 +105,21 @@ def run_study(
     cases = study.cases()
     scenarios = {c.id: study.load_case(c) for c in cases}  # every case valid before anything runs
     out = Path(out_dir)
-    prepare_out(out, study, cases)
-
-    pending = []
-    for case in cases:
+    pending = []  # read before prepare_out, which checks that out holds this study: nothing is written
+    for case in cases:  # before the wall time is judged
         state, _ = case_state(out / "cases" / case.id)
         if state == "pending" or (state == "failed" and retry_failed):
             pending.append(case)
+    check_study_wall_time(
+        run_estimates_s([scenarios[c.id] for c in pending]),
+        workers=workers,
+        scheduler=scheduler,
+        max_wall_minutes=max_wall_minutes,
+        progress=progress,
+        what=f"the study ({len(pending)} of {len(cases)} cases to run)",
+        remedy="shorten operation.t_end_s (--t-end), run fewer cases or more --workers",
+    )
+    prepare_out(out, study, cases)
     skipped = len(cases) - len(pending)
     if progress and skipped:
         print(f"resuming {out}: {skipped} of {len(cases)} cases already done", file=sys.stderr)
