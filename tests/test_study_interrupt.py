@@ -314,7 +314,10 @@ def test_a_case_whose_dask_workers_die_is_failed_once_with_the_cause_and_the_oth
     assert all(by_id[j]["ok"] for j in ("job-0", "job-2", "job-3")), by_id
 
 
-def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path, started_by_nohup):
+@pytest.mark.parametrize("how", ["ctrl-c", "sigterm"])
+def test_an_interrupted_run_prints_one_line_and_exits_130_or_143(tmp_path, started_by_nohup, how):
+    """Ctrl-C (to the group) or SIGTERM (to the process, as ``kill PID``) inside the solver: one line, no
+    result, and the progress bar left where the run stopped (it used to be drawn full)."""
     out = tmp_path / "run"
     cmd = [sys.executable, "-m", "gearbody.cli", "run", SCENE, "--t-end", "20", "--no-plots"]
     cmd += ["--out", str(out)]
@@ -324,11 +327,15 @@ def test_an_interrupted_run_prints_one_line_and_exits_130(tmp_path, started_by_n
         chunk = proc.stderr.read1(4096)
         assert chunk, (seen, proc.wait())
         seen += chunk
-    os.killpg(proc.pid, signal.SIGINT)
+    if how == "ctrl-c":
+        os.killpg(proc.pid, signal.SIGINT)
+    else:
+        proc.send_signal(signal.SIGTERM)
     rest = proc.stderr.read().decode()
-    assert proc.wait(timeout=30) == 130
+    assert proc.wait(timeout=30) == (130 if how == "ctrl-c" else 143)
     assert rest.strip().splitlines()[-1] == "interrupted: gearbody run stopped" and "Traceback" not in rest
     assert not (out / "result.npz").exists()
+    assert "20.000/20.000" not in rest
 
 
 def test_sigterm_stops_a_sweep_that_ignores_ctrl_c(tmp_path):
@@ -620,3 +627,22 @@ def test_sigterm_stops_calibrate_and_sensitivity_and_the_rerun_ends_as_an_uninte
         assert a["parameters"] == b["parameters"] and a["history"] == b["history"]
     else:
         assert _without_wall_times(a) == _without_wall_times(b)
+
+
+def _term_once(flag: str) -> dict:
+    """A job whose first attempt is stopped by SIGTERM from outside (as ``kill PID`` of a worker)."""
+    if not os.path.exists(flag):
+        Path(flag).touch()
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)
+    return {"ok": True, "pid": os.getpid()}
+
+
+def test_a_worker_stopped_by_sigterm_has_its_job_run_again(tmp_path):
+    """SIGTERM is how the pool stops its own workers, so a worker ended by it is not charged with its
+    job: the job runs again on the restarted pool (a SIGKILL or a crash fails it, above)."""
+    jobs = [("a", (str(tmp_path / "a"),)), ("b", (str(tmp_path / "b-done"),))]
+    (tmp_path / "b-done").touch()
+    outcomes = dict(executors.run_pool(_term_once, jobs, workers=2))
+    assert sorted(outcomes) == ["a", "b"] and all(o["ok"] for o in outcomes.values())
+    assert (tmp_path / "a").exists()  # its first attempt was stopped
