@@ -9,6 +9,11 @@ failed, 130 interrupted (Ctrl-C: one line, no traceback), 143 stopped by SIGTERM
 Signals: an inherited SIGINT disposition is kept (a job started with ``cmd &`` from a script ignores
 Ctrl-C on purpose, and so does gearbody); SIGTERM, the way to stop such a job (``kill PID``), stops a
 command as Ctrl-C does: finished cases and evaluations stay recorded and pool workers are stopped.
+Pool workers also die with the command when it is killed outright (SIGKILL;
+:mod:`gearbody.studies.executors`).
+
+Time: a run or study estimates its wall time before it starts (``--max-wall-minutes``,
+:func:`.common.check_wall_time`, :mod:`gearbody.studies.wall`).
 """
 
 from __future__ import annotations
