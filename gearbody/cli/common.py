@@ -100,9 +100,11 @@ def add_wall_limit(parser: argparse.ArgumentParser, what: str) -> None:
 def check_wall_time(scenario, args) -> None:
     """Before a run: its estimated wall time (gearbody.assembly.wall_time) printed on stderr when above
     a minute (unless ``args.quiet``), and an InputError above ``args.max_wall_minutes``."""
+    from gearbody.assembly.stiff_modes import check_resolved_modes
     from gearbody.assembly.wall_time import duration_text, estimate_wall_time, refusal
     from gearbody.errors import InputError
 
+    check_resolved_modes(scenario)  # an absurdly stiff coordinate is named as the cause, not the time
     est = estimate_wall_time(scenario)
     detail = (
         f"{est.simulated_s:g} s simulated at {duration_text(est.wall_per_simulated_s)} per simulated second"
