@@ -329,7 +329,7 @@ def test_a_study_refuses_a_run_folder_and_a_run_refuses_a_study_folder(tmp_path,
     assert main([*SWEEP, "--quiet", "--out", str(study)]) == 0
     capsys.readouterr()
     calibrate = ["calibrate", "one-stage", "--param", "design.mesh.damping_Ns_per_m=3000:12000"]
-    for argv in (["run", "one-stage", *RUN], [*calibrate, "--target", "kd_max", "1", "0.1"]):
+    for argv in (["run", "one-stage", *RUN], [*calibrate, "--target", "kd_max", "1", "0.1", "--quiet"]):
         assert main([*argv, "--out", str(study)]) == 2
         assert f"--out {study} holds a 'gearbody sweep' study (cases, " in _one_line(capsys.readouterr().err)
 

@@ -99,7 +99,7 @@ def test_spectrum_of_a_planetary_run_is_the_ring_sensor_labelled_by_its_lines(pl
     spec = planetary.spectrum()
     assert spec.signal == planetary.vibration_signal_name == "ring_sensor_N"
     f_m = planetary.mesh_frequency_hz(0)
-    assert spec.f_max_hz == pytest.approx(6.5 * f_m)
+    assert spec.f_max_hz == pytest.approx(3.5 * f_m, rel=0.01)  # the run plot's: 3 mesh harmonics
     labelled = [p for p in spec.peaks if p.labels]
     assert labelled, spec.table()
     # a labelled peak lies within the label tolerance of a harmonic of f_m or one of its sidebands

@@ -11,6 +11,11 @@ SIGTERM (the same clean stop).
 Signals: an inherited SIGINT disposition is kept (a job started with ``cmd &`` from a script ignores
 Ctrl-C on purpose, and so does gearbody); SIGTERM, the way to stop such a job (``kill PID``), stops a
 command as Ctrl-C does: finished cases and evaluations stay recorded and pool workers are stopped.
+Pool workers also die with the command when it is killed outright (SIGKILL;
+:mod:`gearbody.studies.executors`).
+
+Time: a run or study estimates its wall time before it starts (``--max-wall-minutes``,
+:func:`.common.check_wall_time`, :mod:`gearbody.studies.wall`).
 """
 
 from __future__ import annotations

@@ -13,6 +13,7 @@ from .common import (
     add_out,
     add_overwrite,
     add_set,
+    add_wall_limit,
     check_out,
     number,
     scenario_overrides,
@@ -109,6 +110,7 @@ def register(sub) -> argparse.ArgumentParser:
     add_executor(ca)
     ca.add_argument("--force", action="store_true", help="allow more evaluations than the limit (2000)")
     ca.add_argument("--quiet", action="store_true", help="no progress and no table")
+    add_wall_limit(ca, "a calibration whose runs still to do are")
     add_out(ca, "output folder of the calibration", required=True)
     add_overwrite(
         ca, "calibration (the fingerprint in its evaluations.jsonl: scene, --set, --case, features, --param)"
@@ -164,6 +166,7 @@ def execute(args) -> int:
             force=args.force,
             progress=not args.quiet,
             overwrite=args.overwrite,
+            max_wall_minutes=args.max_wall_minutes,
         )
     except (SweepSpecError, ImportError) as exc:
         return usage_error("calibrate", str(exc))

@@ -25,7 +25,9 @@ __all__ = [
     "add_out",
     "add_overwrite",
     "add_set",
+    "add_wall_limit",
     "check_options",
+    "check_wall_time",
     "check_out",
     "default_out",
     "load",
@@ -72,6 +74,46 @@ def add_executor(parser: argparse.ArgumentParser) -> None:
         metavar="ADDRESS",
         help="run on a Dask cluster, e.g. tcp://host:8786 (needs: pip install gearbody[sweep])",
     )
+
+
+DEFAULT_MAX_WALL_MINUTES = 30.0
+"""The command line refuses a run or study estimated above this many minutes of wall time unless
+--max-wall-minutes allows more (gearbody.assembly.wall_time): 100x the longest shipped scene at its
+own t_end (planetary, 15 s), above every documented example, and below the 60 s of the planetary scene
+(estimated ~53 min) that used to start unannounced; an estimate above a minute is printed. Within the
+estimate's factor of ~2 a run of 15-60 min may be refused or let through."""
+
+
+def add_wall_limit(parser: argparse.ArgumentParser, what: str) -> None:
+    """``--max-wall-minutes MIN`` into ``args.max_wall_minutes`` (default DEFAULT_MAX_WALL_MINUTES)."""
+    parser.add_argument(
+        "--max-wall-minutes",
+        type=number(gt=0),
+        default=DEFAULT_MAX_WALL_MINUTES,
+        metavar="MIN",
+        help=f"refuse {what} estimated to take more than MIN minutes of wall time, before anything runs "
+        f"(default {DEFAULT_MAX_WALL_MINUTES:g}; an estimate above a minute is printed; a run can also "
+        "be stopped while it runs at solver.wall_time_limit_s)",
+    )
+
+
+def check_wall_time(scenario, args) -> None:
+    """Before a run: its estimated wall time (gearbody.assembly.wall_time) printed on stderr when above
+    a minute (unless ``args.quiet``), and an InputError above ``args.max_wall_minutes``."""
+    from gearbody.assembly.stiff_modes import check_resolved_modes
+    from gearbody.assembly.wall_time import duration_text, estimate_wall_time, refusal
+    from gearbody.errors import InputError
+
+    check_resolved_modes(scenario)  # an absurdly stiff coordinate is named as the cause, not the time
+    est = estimate_wall_time(scenario)
+    detail = (
+        f"{est.simulated_s:g} s simulated at {duration_text(est.wall_per_simulated_s)} per simulated second"
+    )
+    message = refusal(est.wall_s, args.max_wall_minutes, "the run", "shorten operation.t_end_s (--t-end)")
+    if message:
+        raise InputError(f"{message} ({detail})")
+    if est.wall_s > 60 and not args.quiet:
+        print(f"estimated wall time {duration_text(est.wall_s)} ({detail})", file=sys.stderr)
 
 
 def add_out(parser: argparse.ArgumentParser, help: str, required: bool = False) -> None:

@@ -15,7 +15,9 @@ from .common import (
     add_out,
     add_overwrite,
     add_set,
+    add_wall_limit,
     check_out,
+    check_wall_time,
     default_out,
     load,
     number,
@@ -125,6 +127,7 @@ def register(sub) -> argparse.ArgumentParser:
     )
     rd.add_argument("--interactive", action="store_true", help="replay in Exudyn's viewer (needs a display)")
     rd.add_argument("--quiet", action="store_true", help="no progress display")
+    add_wall_limit(rd, "a simulation (SCENE without --result or --kinematic)")
     rd.set_defaults(handler=execute)
     return rd
 
@@ -211,6 +214,7 @@ def execute(args) -> int:
         if args.result is None and not args.kinematic:
             from gearbody.engine import simulate
 
+            check_wall_time(scenario, args)
             if not args.quiet:
                 print(f"simulating {args.scene} ({scenario.operation.t_end_s:g} s) ...")
             result = simulate(scenario, progress=not args.quiet)

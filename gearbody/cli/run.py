@@ -12,7 +12,9 @@ from .common import (
     add_out,
     add_overwrite,
     add_set,
+    add_wall_limit,
     check_out,
+    check_wall_time,
     default_out,
     load,
     number,
@@ -59,6 +61,7 @@ def register(sub) -> argparse.ArgumentParser:
         help="also write DIR/report.html: summary, labelled spectrum, folded K_d, TSA and indicators",
     )
     run.add_argument("--quiet", action="store_true", help="no progress display and no summary on screen")
+    add_wall_limit(run, "a run")
     run.set_defaults(handler=execute)
     return run
 
@@ -104,6 +107,7 @@ def execute(args) -> int:
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
     if not args.no_plots or args.report:
         check_plottable(scenario, args)
+    check_wall_time(scenario, args)
     identity = {"scenario": scenario_to_dict(scenario)}  # what makes a run the same run
     with claim(out, "run", identity, overwrite=args.overwrite) as folder:  # locked while it writes
         t0 = time.perf_counter()

@@ -12,6 +12,7 @@ from .common import (
     add_out,
     add_overwrite,
     add_set,
+    add_wall_limit,
     check_out,
     number,
     scenario_overrides,
@@ -87,6 +88,7 @@ def register(sub) -> argparse.ArgumentParser:
         help="Morris only: compute the indices without the trajectories holding failed runs",
     )
     se.add_argument("--quiet", action="store_true", help="no progress bar and no table")
+    add_wall_limit(se, "an analysis whose runs still to do are")
     add_out(se, "output folder of the analysis", required=True)
     add_overwrite(se, "analysis (its sensitivity.json: scene, --set, --key, --feature, method, sample)")
     se.set_defaults(handler=execute)
@@ -118,6 +120,7 @@ def execute(args) -> int:
             exclude_failed=args.exclude_failed,
             progress=not args.quiet,
             overwrite=args.overwrite,
+            max_wall_minutes=args.max_wall_minutes,
         )
     except (SweepSpecError, FeatureError, ImportError) as exc:
         return usage_error("sensitivity", str(exc))

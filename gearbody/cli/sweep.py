@@ -12,6 +12,7 @@ from .common import (
     add_out,
     add_overwrite,
     add_set,
+    add_wall_limit,
     check_out,
     number,
     scenario_overrides,
@@ -97,6 +98,7 @@ def register(sub) -> argparse.ArgumentParser:
     sw.add_argument("--no-results", action="store_true", help="do not keep result.npz (summaries only)")
     sw.add_argument("--retry-failed", action="store_true", help="on resume, rerun the cases that failed")
     sw.add_argument("--quiet", action="store_true", help="no progress bar and no table")
+    add_wall_limit(sw, "a study whose runs still to do are")
     add_out(sw, "output folder of the study", required=True)
     add_overwrite(sw, "study (its study.json: scene, --set, --vary, --random, --samples, seeds): resumed")
     sw.set_defaults(handler=execute)
@@ -127,6 +129,7 @@ def execute(args) -> int:
             plot_key=args.plot_key,
             max_cases=args.max_cases,
             overwrite=args.overwrite,
+            max_wall_minutes=args.max_wall_minutes,
         )
     except (SweepSpecError, ImportError) as exc:
         return usage_error("sweep", str(exc))

@@ -114,6 +114,7 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
     exudyn.solver.solverCheckMemoryAllocationsThreshold = 2**62
     try:
         exu.SolveDynamic(mbs, settings, solverType=SOLVER_TYPES[sv.method], storeSolver=True, showHints=False)
+        built.watchdog.finished = True
     except Exception as exc:  # a user function raised (stall watchdog) or Exudyn failed
         if built.watchdog.interrupted:  # Ctrl-C inside a user function, reported by Exudyn as its error
             raise KeyboardInterrupt from None

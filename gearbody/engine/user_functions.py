@@ -126,6 +126,7 @@ class StallWatchdog:
             "check stiffness, inertia and load values, or tighten solver tolerances / lower solver.max_step_s"
         )
         self.interrupted = False
+        self.finished = False  # set by the caller when the solver reached t_end
         self._chained: dict[int, object] = {}  # signal -> the handler it replaced while watching
 
     def watch(
@@ -266,8 +267,8 @@ class StallWatchdog:
         for signum, previous in self._chained.items():
             signal.signal(signum, previous)
         self._chained = {}
-        if self.bar is not None:
-            self.bar.n = self.bar.total
+        if self.bar is not None:  # full when the run got to its end, else where it stopped
+            self.bar.n = self.bar.total if self.finished else round(max(self.t_max, 0.0), 6)
             self.bar.close()
             self.bar = None
 

@@ -25,6 +25,7 @@ from .spec import MAX_CASES, Study
 from .store import case_state, prepare_out, write_case
 from .table import DEFAULT_PLOT_VALUE, StudyResult, check_plot_value, collect_rows, write_csv
 from .tasks import run_case
+from .wall import check_study_wall_time, run_estimates_s
 
 __all__ = ["StudyInterrupted", "run_study"]
 
@@ -56,6 +57,7 @@ def run_study(
     plot_key: str | None = None,
     max_cases: int = MAX_CASES,
     overwrite: bool = False,
+    max_wall_minutes: float | None = None,
 ) -> StudyResult:
     """Run a parameter study, resuming whatever ``out_dir`` already holds of it.
 
@@ -74,9 +76,13 @@ def run_study(
         max_cases: most cases the study may have (default :data:`~gearbody.studies.spec.MAX_CASES`).
         overwrite: replace what ``out_dir`` holds (its gearbody outputs are removed first) instead of
             resuming; without it, a folder holding anything but this study is refused.
+        max_wall_minutes: refuse a study whose pending cases are estimated to take longer (default
+            None: no limit; the command line's --max-wall-minutes). With ``progress`` an estimate above
+            a minute is printed (:mod:`gearbody.studies.wall`).
     Raises:
-        SweepSpecError, ScenarioError: bad input (also more than ``max_cases`` cases), before anything
-            runs; ``out_dir`` holds something else than this study (see ``overwrite``).
+        SweepSpecError, ScenarioError: bad input (also more than ``max_cases`` cases, or more than
+            ``max_wall_minutes`` of estimated wall time), before anything runs; ``out_dir`` holds
+            something else than this study (see ``overwrite``).
         FolderInUse: another command is writing in ``out_dir`` (its lock, :mod:`gearbody.folders`).
         OutputError: a file could not be written (a full disk); the cases written stay recorded.
         StudyInterrupted: Ctrl-C (a KeyboardInterrupt); the finished cases are recorded.
@@ -107,15 +113,23 @@ def run_study(
     cases = study.cases()
     scenarios = {c.id: study.load_case(c) for c in cases}  # every case valid before anything runs
     out = Path(out_dir)
+    estimate = [  # the cases still to run, read before anything is written (all of them if replaced)
+        c for c in cases if overwrite or _still_to_run(out / "cases" / c.id, retry_failed)
+    ]
+    check_study_wall_time(
+        run_estimates_s([scenarios[c.id] for c in estimate]),
+        workers=workers,
+        scheduler=scheduler,
+        max_wall_minutes=max_wall_minutes,
+        progress=progress,
+        what=f"the study ({len(estimate)} of {len(cases)} cases to run)",
+        remedy="shorten operation.t_end_s (--t-end), run fewer cases or more --workers",
+    )
     with claim(out, "sweep", overwrite=overwrite) as folder:  # locked while the study writes
         folder.begin()
         prepare_out(out, study, cases)
 
-        pending = []
-        for case in cases:
-            state, _ = case_state(out / "cases" / case.id)
-            if state == "pending" or (state == "failed" and retry_failed):
-                pending.append(case)
+        pending = [c for c in cases if _still_to_run(out / "cases" / c.id, retry_failed)]
         skipped = len(cases) - len(pending)
         if progress and skipped:
             print(f"resuming {out}: {skipped} of {len(cases)} cases already done", file=sys.stderr)
@@ -178,3 +192,9 @@ def run_study(
             f"against {plot_key}",
         )
         return StudyResult(out, keys, rows, len(jobs), skipped, csv_path, plot_path, plot_value)
+
+
+def _still_to_run(case_dir: Path, retry_failed: bool) -> bool:
+    """A case not yet recorded, or recorded as failed when ``retry_failed``."""
+    state, _ = case_state(case_dir)
+    return state == "pending" or (state == "failed" and retry_failed)

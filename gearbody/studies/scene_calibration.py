@@ -51,6 +51,7 @@ from .sensitivity import (
     scene_features,
 )
 from .store import write_json, write_text
+from .wall import check_study_wall_time, run_estimates_s
 
 __all__ = ["MAX_EVALUATIONS", "SceneCalibration", "calibrate_scene", "parse_parameter", "parse_target"]
 
@@ -111,6 +112,15 @@ def parse_target(feature: str, value: str, sigma: str) -> Target:
         raise SweepSpecError(f"{label}: {exc}") from None
 
 
+def _recorded_evaluations(path: Path) -> int:
+    """Evaluation lines of an evaluations.jsonl (0 when there is none or it cannot be read)."""
+    try:
+        with open(path, "rb") as f:
+            return max(0, sum(1 for _ in f) - 1)  # the first line is the fingerprint
+    except OSError:
+        return 0
+
+
 def _cases_used(targets: Sequence[Target], cases: Mapping[str, Sequence[str]]) -> dict[str, tuple[str, ...]]:
     """The cases the targets name, in first-use order, with their overrides ("" = no extra override)."""
     used: dict[str, tuple[str, ...]] = {}
@@ -148,6 +158,7 @@ def calibrate_scene(
     force: bool = False,
     progress: bool = True,
     overwrite: bool = False,
+    max_wall_minutes: float | None = None,
 ) -> SceneCalibration:
     """Fit ``parameters`` (scenario keys with bounds) of ``scene`` (a name or TOML path) to ``targets``
     (features of its ``cases``: ``{name: [KEY=VALUE, ...]}``), every run with ``overrides``.
@@ -156,8 +167,10 @@ def calibrate_scene(
     then at most ``polish_evaluations`` of the least-squares polish, then the Jacobian (parameters + 1).
     Before anything runs: every key, bound and case is loaded as a scenario, every feature parsed and the
     signals it reads looked up in a probe run; more than ``max_evaluations`` are refused unless
-    ``force``. ``out`` resumes the same calibration (its ``evaluations.jsonl`` replayed); ``overwrite``
-    replaces what it holds instead (its gearbody outputs removed first).
+    ``force``, and so are evaluations still to do estimated above ``max_wall_minutes`` of wall time
+    (default None: no limit; :mod:`gearbody.studies.wall`: every case at the costlier end of each
+    parameter's range). ``out`` resumes the same calibration (its ``evaluations.jsonl`` replayed);
+    ``overwrite`` replaces what it holds instead (its gearbody outputs removed first).
 
     Raises SweepSpecError (bad input; ``out`` holds something else, or a record that is not this
     calibration's), FolderInUse (another command writes in ``out``), CalibrationFailed (every evaluation
@@ -214,11 +227,13 @@ def calibrate_scene(
         if key in keys:
             raise SweepSpecError(f"override {o}: {key} is also a --param; give it in one place")
     label, base, sha = read_scene(scene)
+    case_s: list[float] = []  # estimated wall time of a simulation of each case, s
     for case, extra in used.items():
         where = f"case {case!r}" if case else "the fixed overrides"
         specs = [parse_feature(t.feature) for t in targets if t.case == case]
         try:
             scenario = load_scenario(dict(base), [*overrides, *extra])
+            loaded = [scenario]
         except ScenarioError as exc:
             raise SweepSpecError(f"{where}: {exc}") from None
         check_feature_windows(scenario, specs, f" ({where})", "--target")
@@ -226,10 +241,26 @@ def calibrate_scene(
             for v in (p.lower, p.upper, *(() if p.start is None else (p.start,))):
                 try:
                     scenario = load_scenario(dict(base), [*overrides, *extra, f"{p.key}={v!r}"])
+                    loaded.append(scenario)
                 except ScenarioError as exc:
                     raise SweepSpecError(f"--param {p.key}: at {v!r} ({where}): {exc}") from None
                 check_feature_windows(scenario, specs, f" (--param {p.key} at {v!r}, {where})", "--target")
         check_feature_signals(base, [*overrides, *extra], specs)
+        if not all(spec.name == "natural_frequency_hz" for spec in specs):  # else the modes only
+            case_s.append(max(run_estimates_s(loaded)))
+    recorded = _recorded_evaluations(Path(out) / "evaluations.jsonl")  # read only: replayed on resume
+    check_study_wall_time(
+        case_s * batch,
+        workers=workers,
+        scheduler=scheduler,
+        max_wall_minutes=max_wall_minutes,
+        progress=progress,
+        what=f"the calibration (up to {max(0, total - recorded)} of {total} evaluations to do)",
+        remedy="shorten operation.t_end_s (--t-end), lower --budget / --polish-evaluations or give more "
+        "--workers",
+        parallel=batch * len(case_s),
+        repeat=math.ceil(max(0, total - recorded) / batch),
+    )
 
     features = {case: tuple(dict.fromkeys(t.feature for t in targets if t.case == case)) for case in used}
     out = Path(out)

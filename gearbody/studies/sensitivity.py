@@ -47,6 +47,7 @@ from gearbody.version import __version__
 from .executors import check_options, failure, run_jobs
 from .parse import MOST_CASES, SweepSpecError, check_key
 from .store import read_json, write_json, write_text
+from .wall import check_study_wall_time, run_estimates_s
 
 __all__ = [
     "FORMAT",
@@ -497,7 +498,14 @@ def analyse_model(
             (jid, (model, c, [Xl[r] for r in c], keys_t, outputs, tuple(model_args)))
             for jid, c in by_id.items()
         ]
-        _run(jobs, by_id, out, workers, scheduler, progress)
+        try:
+            _run(jobs, by_id, out, workers, scheduler, progress)
+        except KeyboardInterrupt:  # Ctrl-C or SIGTERM: the rows written so far stay recorded
+            done = sum(1 for r in range(n_rows) if r in _recorded(out))
+            raise KeyboardInterrupt(
+                f"interrupted: {done} of {n_rows} runs recorded in {out / 'evaluations'}; rerun the same "
+                "command to resume"
+            ) from None
 
         recorded = _recorded(out)
         failed = [r for r in range(n_rows) if not recorded.get(r, {}).get("ok")]
@@ -620,6 +628,7 @@ def sensitivity(
     scheduler: Any | None = None,
     max_runs: int = MAX_RUNS,
     force: bool = False,
+    max_wall_minutes: float | None = None,
     **options: Any,
 ) -> SensitivityResult:
     """Sensitivity of a scene's ``features`` (specs of :mod:`gearbody.analysis.features`, e.g.
@@ -628,8 +637,9 @@ def sensitivity(
     ``KEY=VALUE`` of every run (``--set``). Before anything runs: every key, range end and sample row
     is checked (its scenario loaded), every feature parsed, and the signals the features read looked
     up in a probe run of :data:`PROBE_S`. More than ``max_runs`` simulations are
-    refused unless ``force``. Other options as for :func:`analyse_model` (levels, second_order,
-    retry_failed, exclude_failed, progress, ...)."""
+    refused unless ``force``, and so are runs still to do estimated above ``max_wall_minutes`` of wall
+    time (default None: no limit; :mod:`gearbody.studies.wall`). Other options as for
+    :func:`analyse_model` (levels, second_order, retry_failed, exclude_failed, progress, ...)."""
     from gearbody.analysis.features import FeatureError, parse_feature
     from gearbody.model import ScenarioError, load_scenario, parse_override
 
@@ -658,8 +668,22 @@ def sensitivity(
                 raise SweepSpecError(f"--key {k}={lo!r}:{hi!r}: at {k} = {v!r}: {exc}") from None
 
     def check(X: np.ndarray) -> None:  # after the options are checked, before anything is written
-        _check_rows(problem, base, overrides, X, parsed)
+        scenarios = _check_rows(problem, base, overrides, X, parsed)
         check_feature_signals(base, overrides, parsed)
+        if all(spec.name == "natural_frequency_hz" for spec in parsed):
+            return  # the modes only: no simulation
+        recorded = _recorded(Path(out))  # read only: a resume runs the rest
+        retry = options.get("retry_failed", False)
+        pending = [r for r in range(len(X)) if r not in recorded or (retry and not recorded[r].get("ok"))]
+        check_study_wall_time(
+            run_estimates_s([scenarios[r] for r in pending]),
+            workers=workers,
+            scheduler=scheduler,
+            max_wall_minutes=max_wall_minutes,
+            progress=options.get("progress", True),
+            what=f"the analysis ({len(pending)} of {len(X)} runs to do)",
+            remedy="shorten operation.t_end_s (--t-end), lower --samples or give more --workers",
+        )
 
     return analyse_model(
         scene_features,
@@ -735,17 +759,20 @@ def check_feature_signals(base: Mapping[str, Any], overrides: Sequence[str], spe
                 )
 
 
-def _check_rows(problem, base, overrides, X: np.ndarray, specs=()) -> None:
-    """Every row's scenario valid (keys that are valid alone may be refused together), and every
-    feature's window in it (:func:`check_feature_windows`)."""
+def _check_rows(problem, base, overrides, X: np.ndarray, specs=()) -> list:
+    """Every row's scenario, each valid (keys that are valid alone may be refused together) and holding
+    every feature's window (:func:`check_feature_windows`)."""
     from gearbody.model import ScenarioError, load_scenario
 
+    scenarios = []
     for r, x in enumerate(X):
         row = [f"{k}={float(v)!r}" for k, v in zip(problem, x, strict=True)]
         try:
             scenario = load_scenario(dict(base), [*overrides, *row])
+            scenarios.append(scenario)
         except ScenarioError as exc:
             raise SweepSpecError(
                 f"sample row {r} ({', '.join(row)}) is not a valid scenario: {exc}"
             ) from None
         check_feature_windows(scenario, specs, f" (sample row {r}: {', '.join(row)})")
+    return scenarios
