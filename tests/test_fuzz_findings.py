@@ -129,3 +129,20 @@ def test_a_stage_type_that_is_no_string_is_refused_naming_it(value):
 
     with pytest.raises(InputError, match=r"design\.stages\.2\.type = .*: must be a string"):
         load_scenario("planetary-conveyor", [f"design.stages.2.type={value}"])
+
+
+@pytest.mark.parametrize(
+    ("override", "named"),
+    [  # on main: OverflowError (floor of an infinite sample count) in the memory budget's estimate
+        ("operation.t_end_s=1.7976931348623157e308", "exceed the memory budget"),
+        ("solver.output_rate_hz=1.7976931348623157e308", "output samples"),
+        ("solver.output_rate_hz=1e308", "output samples"),
+    ],
+)
+def test_a_run_of_more_samples_than_a_float_counts_is_refused_by_the_memory_budget(
+    tmp_path, capsys, override, named
+):
+    out = tmp_path / "run"
+    line = _one_line(capsys, ["run", "two-stage", "--set", override, "--no-plots", "--out", str(out)])
+    assert named in line and "memory budget" in line
+    assert not out.exists()

@@ -112,14 +112,24 @@ def _pinion_speeds_rad_s(scenario: Scenario) -> list[float]:
     return speeds
 
 
+MOST_SAMPLES = 2**62
+"""Output samples counted at most: t_end rate beyond it (up to an infinite product of two finite
+numbers, 1.8e308 s at 20 kHz) is beyond every memory budget all the same."""
+
+
+def _samples(t_end_s: float, rate_hz: float) -> int:
+    points = t_end_s * rate_hz
+    return math.floor(points + 1e-9) + 1 if points < MOST_SAMPLES else MOST_SAMPLES
+
+
 def output_samples(scenario: Scenario) -> int:
     """Samples of the run's output grid, t_k = k / solver.output_rate_hz for k = 0 .. floor(t_end rate)."""
-    return math.floor(scenario.operation.t_end_s * scenario.solver.output_rate_hz + 1e-9) + 1
+    return _samples(scenario.operation.t_end_s, scenario.solver.output_rate_hz)
 
 
 def output_memory_bytes(scenario: Scenario, oversampling_points: int) -> float:
     """Peak memory of the output sampling with ``oversampling_points`` fine points per sample, bytes."""
-    samples = math.floor(scenario.operation.t_end_s * scenario.solver.output_rate_hz + 1e-9) + 1
+    samples = output_samples(scenario)
     per_point = signal_count(scenario) + WORK_ARRAYS_PER_DOF * coordinates(scenario)
     fine = (samples - 1) * oversampling_points + 1 if is_band_limited(scenario) else samples
     return float(fine) * per_point * BYTES_PER_VALUE
@@ -128,7 +138,7 @@ def output_memory_bytes(scenario: Scenario, oversampling_points: int) -> float:
 def estimate(scenario: Scenario) -> Estimate:
     """Memory estimate of a run of ``scenario`` (lower bounds: the run may need more steps)."""
     sv, t_end = scenario.solver, scenario.operation.t_end_s
-    samples = math.floor(t_end * sv.output_rate_hz + 1e-9) + 1
+    samples = _samples(t_end, sv.output_rate_hz)
     M, stage = OVERSAMPLING, None
     if is_band_limited(scenario):
         for k, (st, w_p) in enumerate(zip(scenario.stages, _pinion_speeds_rad_s(scenario), strict=True)):
