@@ -146,3 +146,11 @@ def test_a_run_of_more_samples_than_a_float_counts_is_refused_by_the_memory_budg
     line = _one_line(capsys, ["run", "two-stage", "--set", override, "--no-plots", "--out", str(out)])
     assert named in line and "memory budget" in line
     assert not out.exists()
+
+
+def test_a_batch_beyond_any_study_is_refused(tmp_path, capsys):
+    """On main: OverflowError ('cannot fit int into an index-sized integer') in the wall-time estimate."""
+    argv = ["calibrate", "lateral-6dof", "--param", f"{KEY}=0:0.05", "--target", "kd_max", "1.5", "0.5"]
+    argv += ["--budget", "2", "--batch", "9" * 40, *STUDY, "--out", str(tmp_path / "cal")]
+    assert _one_line(capsys, argv).endswith(f"--batch = {'9' * 40}: at most 100000 points per round")
+    assert not (tmp_path / "cal").exists()

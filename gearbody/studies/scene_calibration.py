@@ -42,7 +42,7 @@ from .calibration import (
     fingerprint,
 )
 from .executors import check_options, run_jobs
-from .parse import SweepSpecError, check_key
+from .parse import MOST_CASES, SweepSpecError, check_key
 from .sensitivity import (
     check_feature_signals,
     check_feature_windows,
@@ -200,6 +200,8 @@ def calibrate_scene(
         batch = 2 if workers is None else max(1, workers)
     if isinstance(batch, bool) or not isinstance(batch, int) or batch < 1:
         raise SweepSpecError(f"--batch must be a whole number >= 1, got {batch!r}")
+    if batch > MOST_CASES:  # points asked of the optimiser at once, and listed for the wall-time estimate
+        raise SweepSpecError(f"--batch = {batch}: at most {MOST_CASES} points per round")
     total = budget + (polish_evaluations if polish else 0) + len(parameters) + 2
     if total > max_evaluations and not force:
         raise SweepSpecError(
