@@ -393,6 +393,9 @@ class Claim:
     option: str = "--out"
     created: bool = False
     """The folder did not exist before: a command that fails before writing anything leaves none."""
+    created_parents: tuple[Path, ...] = ()
+    """Folders made above it (innermost first; ``runs/SCENE`` of ``runs/SCENE/render``): removed too
+    when such a command leaves them empty."""
 
     def begin(self, keep: Iterable[Path] = ()) -> None:
         """Just before the first output is written: the old outputs go (but ``keep``: an input read
@@ -429,18 +432,24 @@ class Claim:
 
     def __exit__(self, exc_type, *exc) -> None:
         self.release()
-        if exc_type is not None and self.created:
-            _remove_if_unused(self.path)
+        if exc_type is not None and self.created and _remove_if_unused(self.path):
+            for parent in self.created_parents:
+                try:
+                    parent.rmdir()  # only if empty: another command may have written in it since
+                except OSError:
+                    break
 
 
-def _remove_if_unused(folder: Path) -> None:
-    """Remove a folder a failed command created, if it holds nothing but the lock file."""
+def _remove_if_unused(folder: Path) -> bool:
+    """Remove a folder a failed command created, if it holds nothing but the lock file; whether it did."""
     try:
         if {p.name for p in folder.iterdir()} <= {LOCK}:
             (folder / LOCK).unlink(missing_ok=True)
             folder.rmdir()
+            return True
     except OSError:
         pass  # someone else's by now, or not ours to remove
+    return False
 
 
 def claim(
@@ -462,6 +471,11 @@ def claim(
         raise ValueError(f"command {command!r}: one of {', '.join(KINDS)}")
     folder = Path(path)
     created = not folder.exists()
+    parents = []
+    for parent in folder.parents:  # the missing ones, innermost first
+        if parent.exists() or parent.is_symlink():
+            break
+        parents.append(parent)
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -481,7 +495,7 @@ def claim(
     except BaseException:
         lock.release()
         raise
-    return Claim(folder, command, identity, state, mode, lock, option, created)
+    return Claim(folder, command, identity, state, mode, lock, option, created, tuple(parents))
 
 
 def _same(command: str, state: FolderState, identity: dict[str, Any] | None) -> bool:

@@ -154,3 +154,15 @@ def test_a_batch_beyond_any_study_is_refused(tmp_path, capsys):
     argv += ["--budget", "2", "--batch", "9" * 40, *STUDY, "--out", str(tmp_path / "cal")]
     assert _one_line(capsys, argv).endswith(f"--batch = {'9' * 40}: at most 100000 points per round")
     assert not (tmp_path / "cal").exists()
+
+
+def test_a_refused_render_leaves_none_of_the_folders_it_made(tmp_path, capsys, monkeypatch):
+    """On main the refused render removed runs/SCENE/render but left runs/SCENE and runs behind."""
+    monkeypatch.chdir(tmp_path)
+    argv = ["render", "lateral-8dof-ball", "--kinematic", "--frames", "1", "--format", "none", "--quiet"]
+    line = _one_line(capsys, [*argv, "--width", "32", "--height", "24", "--end", "3.0"])
+    assert "start_s = 2.94216: must lie in the result's time range" in line
+    assert os.listdir(tmp_path) == []
+    (tmp_path / "runs").mkdir()  # a folder that was there stays
+    _one_line(capsys, [*argv, "--width", "32", "--height", "24", "--end", "3.0"])
+    assert os.listdir(tmp_path) == ["runs"] and os.listdir(tmp_path / "runs") == []

@@ -152,7 +152,7 @@ def execute(args) -> int:
     if not args.interactive:
         check_out(out_dir)
     from gearbody.folders import atomic_write, claim, read_manifest
-    from gearbody.render import RenderError, RenderOptions, check_frames, render, view
+    from gearbody.render import RenderError, RenderOptions, check_frames, check_render, render, view
     from gearbody.result import Result
 
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
@@ -194,6 +194,19 @@ def execute(args) -> int:
             motion = "simulated" if inside else f"result sha256 {_sha256(path)}"
         else:
             motion = "kinematic" if args.kinematic else "simulated"
+        if not args.interactive and (args.result is not None or args.kinematic):
+            # the motion is known: whatever render would refuse is refused before the folder is claimed
+            check_render(
+                scenario,
+                result if args.result is not None else None,
+                frames=24 if args.frames is None else args.frames,
+                start_s=args.start,
+                end_s=args.end,
+                options=options,
+                lateral_scale=args.lateral_scale,
+                movie=args.format,
+                fps=args.fps,
+            )
         if not args.interactive:  # locked while it writes; the old outputs go just before the new ones
             from gearbody.model import scenario_to_dict
 

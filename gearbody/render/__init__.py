@@ -39,6 +39,7 @@ __all__ = [
     "RenderOutput",
     "build_layout",
     "check_frames",
+    "check_render",
     "check_result_matches",
     "kinematic_result",
     "render",
@@ -127,6 +128,42 @@ def render_images(
     yield from _images(layout, result, times_s, options, lateral_scale, lateral_about_mean)
 
 
+def _plan(scenario, result, frames, start_s, end_s, options, lateral_scale, movie, fps):
+    """(layout, motion, frame times) of a render, every refusal of :func:`render` raised first."""
+    if movie not in FORMATS:
+        raise RenderError(f"movie = {movie!r}: must be one of {', '.join(FORMATS)}")
+    if not 0.1 <= fps <= 120:
+        raise RenderError(f"fps = {fps:g}: must lie in [0.1, 120]")
+    if movie == "mp4" and not ffmpeg_available():
+        raise RenderError("movie = 'mp4': ffmpeg is not installed (use 'gif', or install ffmpeg)")
+    if lateral_scale is not None and not 0 <= lateral_scale <= 1e6:
+        raise RenderError(f"lateral_scale = {lateral_scale:g}: must lie in [0, 1e6]")
+    options = options or RenderOptions()
+    options.check()
+    check_frames(frames, options.width_px, options.height_px, movie)
+    layout = build_layout(scenario)
+    result = _motion(scenario, result, layout)
+    return layout, result, frame_times(result, frames, start_s, end_s, layout.input_signal)
+
+
+def check_render(
+    scenario: Scenario,
+    result: Result | None = None,
+    *,
+    frames: int = 24,
+    start_s: float | None = None,
+    end_s: float | None = None,
+    options: RenderOptions | None = None,
+    lateral_scale: float | None = None,
+    movie: str = "gif",
+    fps: float = 20.0,
+) -> None:
+    """RenderError for everything :func:`render` would refuse with these arguments (the movie, its
+    frames, the frame times in the result, the result against the drive), before anything is drawn
+    or written: the command line checks before it claims its output folder."""
+    _plan(scenario, result, frames, start_s, end_s, options, lateral_scale, movie, fps)
+
+
 def render(
     scenario: Scenario,
     result: Result | None = None,
@@ -150,20 +187,9 @@ def render(
     ``lateral_scale`` (default: the scenario's ``visual.lateral_scale``), about its mean over the
     frames unless ``lateral_about_mean`` is False (then the static deflection is magnified too).
     """
-    if movie not in FORMATS:
-        raise RenderError(f"movie = {movie!r}: must be one of {', '.join(FORMATS)}")
-    if not 0.1 <= fps <= 120:
-        raise RenderError(f"fps = {fps:g}: must lie in [0.1, 120]")
-    if movie == "mp4" and not ffmpeg_available():
-        raise RenderError("movie = 'mp4': ffmpeg is not installed (use 'gif', or install ffmpeg)")
-    if lateral_scale is not None and not 0 <= lateral_scale <= 1e6:
-        raise RenderError(f"lateral_scale = {lateral_scale:g}: must lie in [0, 1e6]")
+    plan = _plan(scenario, result, frames, start_s, end_s, options, lateral_scale, movie, fps)
+    layout, result, times = plan
     options = options or RenderOptions()
-    options.check()
-    check_frames(frames, options.width_px, options.height_px, movie)
-    layout = build_layout(scenario)
-    result = _motion(scenario, result, layout)
-    times = frame_times(result, frames, start_s, end_s, layout.input_signal)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     for old in [*out.glob("frame_*.png"), out / "animation.gif", out / "animation.mp4"]:
