@@ -166,3 +166,17 @@ def test_a_refused_render_leaves_none_of_the_folders_it_made(tmp_path, capsys, m
     (tmp_path / "runs").mkdir()  # a folder that was there stays
     _one_line(capsys, [*argv, "--width", "32", "--height", "24", "--end", "3.0"])
     assert os.listdir(tmp_path) == ["runs"] and os.listdir(tmp_path / "runs") == []
+
+
+def test_a_ring_too_small_for_its_pressure_angle_is_refused_naming_its_teeth():
+    """Drawn by the planetary fuzzer (in-range teeth meeting the assembly condition); on main: ValueError
+    'math domain error' in the contact ratio, the ring's tips inside its base circle."""
+    from gearbody.errors import InputError
+    from gearbody.model import load_scenario
+
+    teeth = ["planets=1", "sun.teeth=6", "planet.teeth=6", "ring.teeth=18"]
+    refusal = r"ring\.teeth = 18: the ring's tip circle .* allowed: ring\.teeth >= 23"
+    with pytest.raises(InputError, match=refusal):
+        load_scenario("planetary", [f"design.stages.1.{t}" for t in teeth])
+    fewest = ["planets=1", "sun.teeth=7", "planet.teeth=8", "ring.teeth=23"]
+    load_scenario("planetary", [f"design.stages.1.{t}" for t in fewest])

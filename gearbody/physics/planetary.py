@@ -127,6 +127,7 @@ class PlanetaryGeometry:
                 f"{self.z_sun + 2 * self.z_planet} (off by {mismatch}; ring_teeth_tolerance = {tol})",
                 f"{self.z_sun + 2 * self.z_planet - tol}..{self.z_sun + 2 * self.z_planet + tol}",
             )
+        self._check_ring_flanks()
         given = bool(self.planet_angles_rad)
         if not given:
             self._check_equal_spacing()
@@ -138,6 +139,21 @@ class PlanetaryGeometry:
         self._check_no_overlap(given)
 
     # ----------------------------------------------------------------------------------------- checks
+    def _check_ring_flanks(self) -> None:
+        """The ring's tips point inwards (r_r - m): they must end outside its base circle, where the
+        involute flank begins, z_r (1 - cos alpha) > 2 (standard teeth)."""
+        if self.ring_tip_radius_m > self.ring_base_radius_m:
+            return
+        fewest = math.floor(2.0 / (1.0 - math.cos(self.pressure_angle_rad))) + 1
+        raise _error(
+            "z_ring",
+            self.z_ring,
+            f"the ring's tip circle (radius {self.ring_tip_radius_m * 1e3:.5g} mm) lies inside its base "
+            f"circle ({self.ring_base_radius_m * 1e3:.5g} mm) at pressure_angle_deg = "
+            f"{self.pressure_angle_deg:g}: its teeth would have no involute flank",
+            f"z_ring >= {fewest} at this pressure angle",
+        )
+
     def _check_equal_spacing(self) -> None:
         total = self.z_sun + self.z_ring
         if total % self.n_planets:
