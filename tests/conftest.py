@@ -5,6 +5,9 @@ reference and the docs' examples included."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+
 import pytest
 
 from gearbody.model import Scenario, load_scenario
@@ -37,3 +40,24 @@ def steady_scenario():
 def two_stage() -> Scenario:
     """The two-stage scene as shipped (immutable, so shared by the session)."""
     return load_scenario("two-stage")
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 1 MiB tmpfs mounted in tmp_path (root only; skipped with the reason elsewhere), and a function
+    that fills it to ``pages`` free: ``(disk, fill, filler)``."""
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=1m", "tmpfs", str(disk)], capture_output=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a small filesystem here: {done.stderr.decode().strip()[:100]}")
+    filler = disk / "filler"
+
+    def fill(pages: int) -> None:
+        st = os.statvfs(disk)
+        filler.write_bytes(b"\0" * max(0, (st.f_bavail - pages) * st.f_bsize))
+
+    try:
+        yield disk, fill, filler
+    finally:
+        subprocess.run(["umount", "-l", str(disk)], check=False)

@@ -543,24 +543,7 @@ def test_a_full_disk_in_a_calibration_cuts_no_recorded_evaluation(tmp_path, monk
 # -- a real full disk: a small filesystem the test mounts ---------------------------------------------------
 
 
-@pytest.fixture
-def small_disk(tmp_path):
-    """A 1 MiB tmpfs mounted in tmp_path (root only), and a function that fills it to ``pages`` free."""
-    disk = tmp_path / "disk"
-    disk.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=1m", "tmpfs", str(disk)], capture_output=True)
-    if done.returncode != 0:
-        pytest.skip(f"cannot mount a small filesystem here: {done.stderr.decode().strip()[:100]}")
-    filler = disk / "filler"
-
-    def fill(pages: int) -> None:
-        st = os.statvfs(disk)
-        filler.write_bytes(b"\0" * max(0, (st.f_bavail - pages) * st.f_bsize))
-
-    try:
-        yield disk, fill, filler
-    finally:
-        subprocess.run(["umount", "-l", str(disk)], check=False)
+# small_disk: tests/conftest.py (the fuzzers of a full disk use it too)
 
 
 def test_a_real_full_disk_in_run_and_in_a_sweep_is_one_line_and_resumable(small_disk, capsys):
