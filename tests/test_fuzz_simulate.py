@@ -1,9 +1,14 @@
-"""Extreme-but-valid scenarios simulated (issue 17): hypothesis draws in-range values of the stiffness,
-inertia, damping, error, friction, backlash, speed and load keys of four scenes, and each is simulated
-for 0.01 s in a worker process capped at WORKER_MEMORY_BYTES of address space. Every example must end
-within CASE_TIMEOUT_S in a result or a documented error (InputError, exit 2, or SimulationError,
-exit 3) whose message is gearbody's own: no Exudyn banner, no traceback, no Python repr. The outcome
-counts are printed at the end of the run."""
+"""Extreme-but-valid scenarios simulated (issues 17, 26): hypothesis draws in-range values of the
+stiffness, inertia, damping, error, friction, backlash, speed and load keys of four scenes, and (issue 26)
+of the planetary stages (planet counts meeting the assembly condition, tooth counts up to the bound,
+pin errors up to a tenth of the module, member bearings, linear or Hertzian, planet bearing defects)
+and of the lateral scenes' bearings (stiffness, damping, clearance, exponent, housing mass); each is
+simulated for 0.01 s in a worker process capped at WORKER_MEMORY_BYTES of address space. Every example
+must end within CASE_TIMEOUT_S in a result or a documented error (InputError, exit 2, or
+SimulationError, exit 3) whose message is gearbody's own: no Exudyn banner, no traceback, no Python
+repr. The outcome counts are printed at the end of the run; a failure names the ``gearbody run``
+command line that reproduces it. Examples: EXAMPLES and PLANETARY_EXAMPLES times GEARBODY_FUZZ_SCALE
+(tests/fuzzing.py: derandomized, no database, no local constants)."""
 
 from __future__ import annotations
 
@@ -13,6 +18,7 @@ import os
 import re
 import resource
 import select
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -21,12 +27,14 @@ from pathlib import Path
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, Phase, given, settings  # noqa: E402
+from fuzzing import Report, fuzz_settings  # noqa: E402
+from hypothesis import given  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 pytestmark = pytest.mark.slow
 
 EXAMPLES = 300
+PLANETARY_EXAMPLES = 12
 CASE_TIMEOUT_S = 60.0
 WORKER_MEMORY_BYTES = 3 * 2**30
 T_END_S = 0.01
@@ -170,8 +178,10 @@ def worker(request):
         w.outcomes = collections.Counter()
         w.errors = []
         w.walls = []
+        w.report = Report("simulate")
         yield w
         w.stop()
+        w.report.write()
         printed = w.stderr_path.read_text() if w.stderr_path.exists() else ""
         reporter = request.config.pluginmanager.get_plugin("terminalreporter")
         capture = request.config.pluginmanager.get_plugin("capturemanager")
@@ -189,23 +199,19 @@ def worker(request):
             assert text not in printed, f"a run printed {text!r}"
 
 
-@settings(
-    max_examples=EXAMPLES,
-    deadline=None,
-    derandomize=True,
-    database=None,
-    # No shrinking: each shrink step is a simulation, and hypothesis shrinks for up to 5 min; the first
-    # failing case is reported as drawn (its scene and overrides are in the assertion message).
-    phases=[Phase.explicit, Phase.reuse, Phase.generate],
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
-@given(case=cases())
-def test_extreme_valid_scenarios_end_in_a_result_or_a_documented_error(worker, case):
-    scene, overrides = case
+def reproduce(scene: str, overrides: list[str]) -> str:
+    """The command line that runs the case as the fuzzer did (``--no-plots``: 0.01 s has too few samples
+    for the plots)."""
+    sets = " ".join(f"--set {shlex.quote(o)}" for o in overrides)
+    return f"gearbody run {scene} {sets} --no-plots"
+
+
+def check_case(worker, scene: str, overrides: list[str], kind: str) -> None:
     answer = worker.run(scene, overrides)
     worker.outcomes[answer["outcome"]] += 1
+    worker.report.add(kind, answer["outcome"])
     worker.walls.append(answer.get("wall_s", CASE_TIMEOUT_S))
-    where = f"{scene} {overrides}"
+    where = reproduce(scene, overrides)
     if answer["outcome"] != "result":
         worker.errors.append(f"{answer['outcome']}: {answer.get('message', '')[:150]} <- {where}")
     assert answer["outcome"] in ("result", "InputError", "SimulationError"), f"{where}: {answer}"
@@ -218,3 +224,125 @@ def test_extreme_valid_scenarios_end_in_a_result_or_a_documented_error(worker, c
         typed = re.sub(r"--(set|vary|random) \S+", "", message)  # the override quoted as the user typed it
         assert not PYTHON_REPR.search(typed), f"{where}: {message}"
     assert answer["wall_s"] < CASE_TIMEOUT_S, where
+
+
+# No shrinking: each shrink step is a simulation, and hypothesis shrinks for up to 5 min; the first
+# failing case is reported as drawn (the command line that reproduces it is in the assertion message).
+@fuzz_settings(EXAMPLES, shrink=False)
+@given(case=cases())
+def test_extreme_valid_scenarios_end_in_a_result_or_a_documented_error(worker, case):
+    scene, overrides = case
+    check_case(worker, scene, overrides, "parallel")
+
+
+# -- planetary stages and bearings: every draw within the documented ranges -----------------------------
+
+PLANETARY_SCENES = ("planetary", "planetary-conveyor")
+BEARING_SCENES = ("lateral-8dof", "lateral-6dof", "lateral-8dof-ball")
+
+
+def _planetary_stage(scene: str) -> tuple[str, float]:
+    """(key prefix, module in mm) of the scene's planetary stage."""
+    from gearbody.model import load_scenario
+
+    for k, stage in enumerate(load_scenario(scene).stages, start=1):
+        if getattr(stage, "type", "") == "planetary":
+            return f"design.stages.{k}", stage.module_mm
+    raise AssertionError(scene)
+
+
+def _hertzian(draw) -> str:
+    k = draw(_log_uniform(8, 12))
+    c = draw(st.one_of(st.just(0.0), _log_uniform(-7, -4)))
+    n = draw(st.sampled_from([1.0, 10 / 9, 1.5, 2.0]) | st.floats(1.0, 2.0))
+    d = draw(st.one_of(st.just(0.0), _log_uniform(0, 5)))
+    return (
+        f"{{kind='hertzian',parameters={{contact_stiffness_N_per_m_n={k!r},radial_clearance_m={c!r},"
+        f"exponent={n!r},damping_Ns_per_m={d!r}}}}}"
+    )
+
+
+@st.composite
+def planetary_cases(draw) -> tuple[str, list[str]]:
+    """A planetary scene with in-range extremes: N planets meeting the assembly condition (z_s + z_r)/N
+    whole with z_r = z_s + 2 z_p <= 2000, pin errors up to a tenth of the module, member bearings
+    (linear, or a Hertzian law), planet bearing defects, meshes, friction."""
+    scene = draw(st.sampled_from(PLANETARY_SCENES))
+    stage, module_mm = _planetary_stage(scene)
+    overrides = [f"operation.t_end_s={T_END_S}"]
+    choices = ("teeth", "pins", "bearings", "laws", "defects", "meshes", "friction")
+    chosen = draw(st.lists(st.sampled_from(choices), min_size=1, max_size=4, unique=True))
+    planets = 3
+    if "teeth" in chosen:
+        planets = draw(st.integers(1, 12))
+        z_p = draw(st.one_of(st.integers(6, 60), st.integers(6, 660)))
+        z_s = draw(st.one_of(st.integers(6, 80), st.integers(6, 2000 - 2 * z_p - planets)))
+        while (2 * z_s + 2 * z_p) % planets:  # the assembly condition: (z_s + z_r) / N whole
+            z_s += 1
+        z_r = z_s + 2 * z_p
+        overrides += [f"{stage}.planets={planets}", f"{stage}.sun.teeth={z_s}", f"{stage}.planet.teeth={z_p}"]
+        overrides.append(f"{stage}.ring.teeth={z_r}")
+    if "pins" in chosen:
+        bound = 100.0 * module_mm  # a tenth of the module, in um
+        error = st.sampled_from([bound, -bound, 0.0]) | st.floats(-bound, bound)
+        errors = draw(st.lists(error, min_size=planets, max_size=planets))
+        overrides.append(f"{stage}.planet_position_errors_um=[{', '.join(repr(e) for e in errors)}]")
+    members = ("sun", "planet", "ring", "carrier")
+    if "bearings" in chosen:
+        for member in draw(st.lists(st.sampled_from(members), min_size=1, max_size=4, unique=True)):
+            overrides.append(f"{stage}.{member}.bearing_stiffness_N_per_m={draw(_log_uniform(5, 11))!r}")
+            damping = draw(st.one_of(st.just(0.0), _log_uniform(0, 5)))
+            overrides.append(f"{stage}.{member}.bearing_damping_Ns_per_m={damping!r}")
+    if "laws" in chosen:  # a law replaces the member's linear bearing
+        for member in draw(st.lists(st.sampled_from(members), min_size=1, max_size=2, unique=True)):
+            overrides.append(f"{stage}.{member}.bearing_stiffness_N_per_m=0.0")
+            overrides.append(f"{stage}.{member}.bearing={_hertzian(draw)}")
+    if "defects" in chosen:
+        which = draw(st.lists(st.integers(1, planets), min_size=1, max_size=planets, unique=True))
+        factors = [draw(st.sampled_from([1e-6, 0.5, 1.0]) | st.floats(1e-6, 1.0)) for _ in which]
+        entries = ", ".join(
+            f"{{planet={p}, stiffness_factor={f!r}}}" for p, f in zip(which, factors, strict=True)
+        )
+        overrides.append(f"{stage}.planet_bearing_defects=[{entries}]")
+    if "meshes" in chosen:
+        for mesh in draw(
+            st.lists(st.sampled_from(["sun_mesh", "ring_mesh"]), min_size=1, max_size=2, unique=True)
+        ):
+            overrides.append(
+                f"{stage}.{mesh}.damping_Ns_per_m={draw(st.one_of(st.just(0.0), _log_uniform(0, 6)))!r}"
+            )
+            overrides.append(f"{stage}.{mesh}.backlash_um={draw(st.floats(0, 500))!r}")
+    if "friction" in chosen:
+        overrides.append(f"condition.friction_coefficient={draw(st.floats(0, 0.3))!r}")
+    overrides.append(f'operation.initial_state="{draw(st.sampled_from(["steady", "steady", "rest"]))}"')
+    return scene, overrides
+
+
+@st.composite
+def bearing_cases(draw) -> tuple[str, list[str]]:
+    """A lateral scene with in-range bearing extremes: linear stiffness and damping per direction, or a
+    Hertzian law (stiffness, clearance, exponent in [1, 2], damping), and the housing mass."""
+    scene = draw(st.sampled_from(BEARING_SCENES))
+    overrides = [f"operation.t_end_s={T_END_S}"]
+    for gear in draw(st.lists(st.sampled_from(["pinion", "wheel"]), min_size=1, max_size=2, unique=True)):
+        key = f"design.{gear}.bearing"
+        if draw(st.booleans()):
+            overrides.append(f"{key}={_hertzian(draw)}")
+        else:
+            kx, ky = draw(_log_uniform(5, 12)), draw(_log_uniform(5, 12))
+            cx, cy = (draw(st.one_of(st.just(0.0), _log_uniform(0, 6))) for _ in range(2))
+            overrides.append(
+                f"{key}={{kind='linear',parameters={{stiffness_x_N_per_m={kx!r},stiffness_y_N_per_m={ky!r},"
+                f"damping_x_Ns_per_m={cx!r},damping_y_Ns_per_m={cy!r}}}}}"
+            )
+        if draw(st.booleans()):
+            overrides.append(f"{key}.housing_mass_kg={draw(_log_uniform(-3, 4))!r}")
+    overrides.append(f'operation.initial_state="{draw(st.sampled_from(["steady", "rest"]))}"')
+    return scene, overrides
+
+
+@fuzz_settings(PLANETARY_EXAMPLES, shrink=False)
+@given(case=st.one_of(planetary_cases(), bearing_cases()))
+def test_in_range_planetary_and_bearing_extremes_end_in_a_result_or_a_documented_error(worker, case):
+    scene, overrides = case
+    check_case(worker, scene, overrides, "planetary" if scene in PLANETARY_SCENES else "bearings")
