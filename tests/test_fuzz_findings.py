@@ -180,3 +180,46 @@ def test_a_ring_too_small_for_its_pressure_angle_is_refused_naming_its_teeth():
         load_scenario("planetary", [f"design.stages.1.{t}" for t in teeth])
     fewest = ["planets=1", "sun.teeth=7", "planet.teeth=8", "ring.teeth=23"]
     load_scenario("planetary", [f"design.stages.1.{t}" for t in fewest])
+
+
+def _dies_once(flag: str, what: str) -> dict:
+    """A job whose worker is killed the first time it runs (``flag`` marks that it has been)."""
+    import signal
+
+    if what == "kill" and not os.path.exists(flag):
+        open(flag, "w").close()
+        os.kill(os.getpid(), signal.SIGKILL)
+    return {"ok": True, "value": what}
+
+
+def test_a_worker_that_dies_while_the_jobs_are_handed_out_fails_no_other_job(tmp_path, monkeypatch):
+    """Found by the interruption matrix (SIGKILL to a calibration's pool worker): the pool broke while
+    run_pool was still submitting, and submit's BrokenProcessPool escaped as a traceback. Here the
+    first job's worker dies and the next submit waits until the pool knows it (the race, made sure)."""
+    import time
+    from concurrent.futures import ProcessPoolExecutor
+
+    from gearbody.studies import executors
+
+    real_submit = ProcessPoolExecutor.submit
+    held: list[bool] = []
+
+    def submit_after_the_death(self, *args, **kwargs):
+        future = real_submit(self, *args, **kwargs)
+        if not held:  # the first pool only: wait until its first worker's death has broken it
+            held.append(True)
+            t0 = time.monotonic()
+            while not self._broken and time.monotonic() - t0 < 30:
+                time.sleep(0.01)
+            assert self._broken
+        return future
+
+    monkeypatch.setattr(ProcessPoolExecutor, "submit", submit_after_the_death)
+    flag = str(tmp_path / "killed")
+    jobs = [(f"job-{i}", (flag, w)) for i, w in enumerate(["kill", "a", "b", "c", "d"])]
+    outcomes = list(executors.run_pool(_dies_once, jobs, workers=2))
+    assert sorted(jid for jid, _ in outcomes) == sorted(jid for jid, _ in jobs)  # each exactly once
+    by_id = dict(outcomes)
+    assert all(by_id[f"job-{i}"]["ok"] for i in range(1, 5))
+    first = by_id["job-0"]  # charged with its worker's death, or (the pool let go of it) run again
+    assert first["ok"] or first["message"].startswith("worker process died (signal 9, SIGKILL)")

@@ -201,6 +201,11 @@ def death_cause(exitcode: int | None) -> str:
     return f"worker process exited with code {exitcode}"
 
 
+def _pool_processes(pool: ProcessPoolExecutor) -> list:
+    """The pool's worker processes (none once a broken pool has let go of them)."""
+    return list((getattr(pool, "_processes", None) or {}).values())
+
+
 def run_pool(
     task: Task, jobs: Sequence[Job], workers: int, mark_dir: str | Path | None = None
 ) -> Iterator[tuple[str, dict]]:
@@ -221,11 +226,15 @@ def run_pool(
             processes: list = []
             broken = done = False
             try:
-                with _stop_signals_held():  # the workers are forked in submit
-                    for jid, args in todo.items():
-                        futures[pool.submit(_marked, str(marks), task, jid, args)] = jid
-                    processes = list(getattr(pool, "_processes", {}).values())  # fork: all started by now
-                for fut in as_completed(futures):
+                try:
+                    with _stop_signals_held():  # the workers are forked in submit
+                        for jid, args in todo.items():
+                            futures[pool.submit(_marked, str(marks), task, jid, args)] = jid
+                        processes = _pool_processes(pool)  # fork: all started by now
+                except BrokenProcessPool:  # a worker died while the jobs were handed out: as below
+                    broken = True
+                    processes = _pool_processes(pool)
+                for fut in [] if broken else as_completed(futures):
                     try:
                         outcome = fut.result()
                     except BrokenProcessPool:  # a worker died: which one, and running what, below
@@ -235,10 +244,10 @@ def run_pool(
                         outcome = failure(exc)
                     del todo[futures[fut]]
                     yield futures[fut], outcome
-                done = True
+                done = not broken
             finally:
                 if not done:  # interrupted, closed early or broken: stop every worker now
-                    processes = processes or list(getattr(pool, "_processes", {}).values())
+                    processes = processes or _pool_processes(pool)
                     for p in processes:
                         p.terminate()
                 pool.shutdown(wait=True, cancel_futures=True)
