@@ -223,3 +223,15 @@ def test_a_worker_that_dies_while_the_jobs_are_handed_out_fails_no_other_job(tmp
     assert all(by_id[f"job-{i}"]["ok"] for i in range(1, 5))
     first = by_id["job-0"]  # charged with its worker's death, or (the pool let go of it) run again
     assert first["ok"] or first["message"].startswith("worker process died (signal 9, SIGKILL)")
+
+
+def test_a_quiet_sweep_with_a_failed_case_says_so_in_one_line(tmp_path, capsys):
+    """Found by the interruption matrix (SIGKILL to a sweep's pool worker, --quiet): exit 1 and nothing
+    on stderr; the failed cases were only in summary.csv."""
+    overload = "operation.load_profile={time_s=[0.0],fraction=[1.0]},{time_s=[0.0],fraction=[5.0]}"
+    out = tmp_path / "study"
+    line = _one_line(capsys, ["sweep", "two-wheel", "--vary", overload, *STUDY, "--out", str(out)], code=1)
+    assert line.startswith("gearbody sweep: 1 of 2 cases failed (case-0001: ")
+    assert line.endswith(
+        f"each is recorded in {out / 'summary.csv'}; rerun with --retry-failed to run them again"
+    )

@@ -4,6 +4,7 @@ ran, 1 some failed, 2 bad input, 130 interrupted (rerun to resume)."""
 from __future__ import annotations
 
 import argparse
+import sys
 
 from .common import (
     EXIT_FAILED,
@@ -135,4 +136,12 @@ def execute(args) -> int:
         return usage_error("sweep", str(exc))
     if not args.quiet:
         print(study.table())
+    if not study.all_ok:  # one line, --quiet or not: exit 1 never goes unexplained
+        failed = [r for r in study.rows if r["status"] == "failed"]
+        first = f" ({failed[0]['id']}: {str(failed[0].get('error') or '').strip()[:200]})" if failed else ""
+        print(
+            f"gearbody sweep: {len(failed)} of {len(study.rows)} cases failed{first}; each is recorded in "
+            f"{study.csv_path}; rerun with --retry-failed to run them again",
+            file=sys.stderr,
+        )
     return EXIT_OK if study.all_ok else EXIT_FAILED
