@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from fuzzing import GOOD, CommandRunner, Report, fuzz_settings, leaves, print_line
+from fuzzing import GOOD, SCALE, CommandRunner, Report, fuzz_settings, leaves, print_line
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -536,8 +536,10 @@ def test_every_scenario_file_kind_on_every_command_ends_cleanly(runner, kind):
 
 @pytest.mark.parametrize("kind", OUT_PATHS)
 def test_every_output_path_kind_on_every_writing_command_ends_cleanly(runner, kind):
-    """Each odd --out given to each command that writes one: written, or refused in one line."""
-    for command in ("new", "run", "mesh", "sweep", "sensitivity", "calibrate", "render"):
+    """Each odd --out given to each command that writes one: written, or refused in one line (at the
+    default scale four of them: CI's time)."""
+    writers = ("new", "run", "mesh", "sweep", "sensitivity", "calibrate", "render")
+    for command in writers if SCALE >= 2 else ("new", "run", "sweep", "render"):
         tokens = [
             command,
             "two-wheel",
