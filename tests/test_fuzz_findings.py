@@ -235,3 +235,38 @@ def test_a_quiet_sweep_with_a_failed_case_says_so_in_one_line(tmp_path, capsys):
     assert line.endswith(
         f"each is recorded in {out / 'summary.csv'}; rerun with --retry-failed to run them again"
     )
+
+
+def test_a_run_that_creeps_is_stalled_relative_to_the_period_it_resolves():
+    """The watchdog's threshold follows the shortest period the run resolves (STALL_FRACTION of it):
+    2e-7 s per STALL_CALLS evaluations is a stall at the default 20 kHz output, progress at 100 MHz."""
+    from gearbody.engine.user_functions import STALL_CALLS, StallError, StallWatchdog
+
+    def creep(period_s: float) -> None:
+        dog = StallWatchdog()
+        dog.watch(1.0, 1e3, False, "motor speed", "rad/s", max_step_s=1e-4, resolved_period_s=period_s)
+        for k in range(3 * STALL_CALLS):
+            dog(2e-7 * k / STALL_CALLS, 100.0)
+
+    with pytest.raises(StallError, match=r"200000 force evaluations advanced less than 5e-07 s"):
+        creep(1 / 20000)
+    creep(1e-8)  # 2e-7 s is ~20 periods of 100 MHz: progress
+
+
+@pytest.mark.slow
+def test_the_muller_run_that_crept_for_ever_is_a_numerical_failure(tmp_path, capsys):
+    """Drawn by the simulation fuzzer: 0.01 s had not finished after 5 min (~1e-12 s per step at a jump
+    of the mesh law); the absolute 1e-9 s per check never called it stalled. The wall-time limit is
+    only this test's bound."""
+    sets = [
+        "operation.t_end_s=0.01",
+        "design.motor.synchronous_speed_rad_s=14.113160201108897",
+        "design.motor.inertia_kg_m2=0.011999723692969953",
+        "operation.speed_profile={time_s = [0.0], fraction = [2.3279138811885858]}",
+        "production.error_mode.e_um=88.26977995229572",
+        "design.mesh.damping_Ns_per_m=1533475.9328450963",
+        "solver.wall_time_limit_s=120",
+    ]
+    argv = ["run", "muller", *[a for s in sets for a in ("--set", s)], "--no-plots", "--quiet"]
+    line = _one_line(capsys, [*argv, "--out", str(tmp_path / "run")], code=3)
+    assert "the solver stalled at t = 0.0047" in line and "advanced less than 5e-07 s" in line

@@ -100,6 +100,7 @@ def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
         memory_limit_bytes=memory_limit_bytes(scenario),
         memory_limit_default=sv.memory_limit_MiB is None,
         max_step_s=sv.max_step_s,
+        resolved_period_s=1.0 / max(sv.output_rate_hz, 1.0 / sv.max_step_s),
         stall_hint=stall_hint(scenario),
         divergence_hint=divergence_hint(scenario),
     )

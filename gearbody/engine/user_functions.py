@@ -79,6 +79,14 @@ class StallError(RuntimeError):
 CHECK_CALLS = 2_000  # force evaluations between divergence checks and progress updates (~250 attempts)
 STALL_CALLS = 200_000  # force evaluations per stall check (~30k steps: ~0.1 s simulated normally)
 STALL_ADVANCE_S = 1e-9
+STALL_FRACTION = 1e-2
+"""A stall: STALL_CALLS force evaluations advanced less than STALL_FRACTION of the shortest period the
+run resolves, 1 / max(solver.output_rate_hz, 1 / solver.max_step_s) (5e-7 s by default), and at least
+STALL_ADVANCE_S. A run's steps are never shorter than ~1 / (2 pi) of the fastest rate it may hold,
+MODE_RATE_FACTOR = 10 times that resolved rate (gearbody.assembly.stiff_modes): its ~30k steps per check
+advance ~5e2 such periods, 5e4 times the threshold. A run chattering at a jump of a force law crept on
+at ~1e-12 s per step: 0.01 s simulated had not finished after 5 min, and the absolute 1e-9 s alone
+never called it stalled."""
 
 
 PAGE_BYTES = os.sysconf("SC_PAGE_SIZE") if hasattr(os, "sysconf") else 4096
@@ -121,6 +129,7 @@ class StallWatchdog:
         self.memory_limit_default = False
         self.memory0_bytes = 0
         self.max_step_s = math.inf
+        self.stall_advance_s = STALL_ADVANCE_S
         self.stall_hint = ""
         self.divergence_hint = (
             "check stiffness, inertia and load values, or tighten solver tolerances / lower solver.max_step_s"
@@ -141,18 +150,21 @@ class StallWatchdog:
         memory_limit_bytes: float | None = None,
         memory_limit_default: bool = False,
         max_step_s: float = math.inf,
+        resolved_period_s: float = 0.0,
         stall_hint: str = "",
         divergence_hint: str = "",
     ) -> None:
         """Set what the run watches: divergence above ``speed_limit`` of the watched speed, a progress
-        bar, the wall-time and memory budgets (None: unlimited), the largest step and the scenario's
-        likely causes of a stall or a divergence (hints for the messages)."""
+        bar, the wall-time and memory budgets (None: unlimited), the largest step, the shortest period
+        the run resolves (the stall threshold, STALL_FRACTION of it) and the scenario's likely causes of
+        a stall or a divergence (hints for the messages)."""
         self.t_end, self.speed_limit, self.progress = t_end, speed_limit, progress
         self.speed_name, self.speed_unit = name, unit
         self.wall_time_limit_s = math.inf if wall_time_limit_s is None else wall_time_limit_s
         self.memory_limit_bytes = math.inf if memory_limit_bytes is None else memory_limit_bytes
         self.memory_limit_default = memory_limit_default
         self.max_step_s, self.stall_hint = max_step_s, stall_hint
+        self.stall_advance_s = max(STALL_ADVANCE_S, STALL_FRACTION * resolved_period_s)
         self.divergence_hint = divergence_hint or self.divergence_hint
         if memory_limit_bytes is not None:
             self.memory0_bytes = resident_memory_bytes()
@@ -213,7 +225,7 @@ class StallWatchdog:
             )
             raise StallError(self.failure)
         if self.calls % STALL_CALLS == 0:
-            if self.t_max - self.t_check < STALL_ADVANCE_S:
+            if self.t_max - self.t_check < self.stall_advance_s:
                 raise StallError(self._stalled())
             self.t_check = self.t_max
             if self.memory_limit_bytes < math.inf:
@@ -246,9 +258,9 @@ class StallWatchdog:
     def _stalled(self) -> str:
         what = (
             f"the solver stalled at t = {self.t_max:.9g} s: {STALL_CALLS} force evaluations advanced "
-            f"less than {STALL_ADVANCE_S:g} s"
+            f"less than {self.stall_advance_s:g} s"
         )
-        if self.max_step_s * STALL_CALLS < 100 * STALL_ADVANCE_S:  # the largest step itself is too short
+        if self.max_step_s * STALL_CALLS < 100 * self.stall_advance_s:  # the largest step itself is too short
             self.failure = (
                 f"{what}: solver.max_step_s = {self.max_step_s:g} s caps every step. Hint: raise "
                 "solver.max_step_s (default 1e-4 s)"
