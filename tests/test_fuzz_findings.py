@@ -237,6 +237,22 @@ def test_a_quiet_sweep_with_a_failed_case_says_so_in_one_line(tmp_path, capsys):
     )
 
 
+def test_render_interactive_without_a_display_is_refused_before_it_simulates(tmp_path, capsys, monkeypatch):
+    """On main the scene was simulated first (the whole run) and then refused, naming the Python API
+    ('use render() for pictures')."""
+    import gearbody.engine
+
+    def no_simulation(*args, **kwargs):
+        raise AssertionError("simulated for a viewer that cannot open")
+
+    monkeypatch.setattr(gearbody.engine, "simulate", no_simulation)
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    line = _one_line(capsys, ["render", "two-wheel", "--interactive", "--out", str(tmp_path / "r")])
+    assert line.startswith("gearbody render: --interactive: no display to open Exudyn's viewer on")
+    assert "render()" not in line and not (tmp_path / "r").exists()
+
+
 def test_a_run_that_creeps_is_stalled_relative_to_the_period_it_resolves():
     """The watchdog's threshold follows the shortest period the run resolves (STALL_FRACTION of it):
     2e-7 s per STALL_CALLS evaluations is a stall at the default 20 kHz output, progress at 100 MHz."""

@@ -153,7 +153,15 @@ def execute(args) -> int:
         check_out(out_dir)
     from gearbody.folders import atomic_write, claim, read_manifest
     from gearbody.render import RenderError, RenderOptions, check_frames, check_render, render, view
+    from gearbody.render.scene3d import has_display
     from gearbody.result import Result
+
+    if args.interactive and not has_display():  # before a scene is simulated for a viewer never shown
+        return usage_error(
+            "render",
+            "--interactive: no display to open Exudyn's viewer on (neither DISPLAY nor WAYLAND_DISPLAY is "
+            "set); leave out --interactive to write the frames and the animation",
+        )
 
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
     options = RenderOptions(
