@@ -394,6 +394,7 @@ def options(command: str) -> list[Option]:
             "--no-housing": st.none(),
             "--lateral-scale": n,
             "--lateral-static": st.none(),
+            "--interactive": st.none(),  # (the runner has no display: refused before anything runs)
             "--background": st.sampled_from(
                 ["1,1,1", "0,0,0", "2,0,0", "nan,0,0", "1,1", "1,1,1,1", "", "a,b,c"]
             ),

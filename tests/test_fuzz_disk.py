@@ -26,7 +26,7 @@ STUDY = ["--t-end", "0.003", "--workers", "1", "--quiet"]
 WRITERS = {
     "run": ["run", "SCENE", "--t-end", "0.003", "--no-plots", "--quiet"],
     "run with plots": ["run", "SCENE", "--t-end", "0.01", "--report", "--quiet"],
-    "new": ["new", "SCENE"],
+    "new": ["new", "SCENE", "--overwrite"],  # (run again once it fitted: replaces its own file)
     "mesh": ["mesh", "SCENE"],
     "render": ["render", "SCENE", "--kinematic", "--frames", "2", "--width", "64", "--height", "48"]
     + ["--quiet"],
