@@ -196,6 +196,7 @@ BAD_OPTIONS = [
     (["mesh", "one-stage"], "--stage", "0", ">= 1"),
     (["mesh", "one-stage"], "--load", "-1", ">= 0"),
     (["mesh", "one-stage"], "--load", "nan", ">= 0"),
+    (["mesh", "one-stage"], "--load", "1e300", "<= 100"),
     (["sweep", "one-stage", "--out", "x"], "--workers", "0", ">= 1 and <= 256"),
     (["sweep", "one-stage", "--out", "x"], "--samples", "0", ">= 1"),
     (["sweep", "one-stage", "--out", "x"], "--seeds", "-2", ">= 1"),

@@ -19,6 +19,11 @@ from .common import (
     usage_error,
 )
 
+MAX_LOAD_FRACTION = 100.0
+"""Largest --load: the static TE is linear in the load, and a hundred times the rated force already
+deflects a mesh far beyond the lumped model's range (0.1 of the base pitch); 1e300 printed numbers
+of 300 digits."""
+
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
@@ -50,10 +55,13 @@ def register(sub) -> argparse.ArgumentParser:
     add_overwrite(me, "scenario (scene and --set)")
     me.add_argument(
         "--load",
-        type=number(ge=0),
+        type=number(ge=0, le=MAX_LOAD_FRACTION),
         default=1.0,
         metavar="FRACTION",
-        help="static TE at this fraction of each stage's rated force (default 1)",
+        help=(
+            f"static TE at this fraction of each stage's rated force (default 1, at most "
+            f"{MAX_LOAD_FRACTION:g})"
+        ),
     )
     me.add_argument("--no-plots", action="store_true", help="print the tables only, write no PNGs")
     me.set_defaults(handler=execute)
@@ -68,8 +76,10 @@ def execute(args) -> int:
         return usage_error(
             "mesh", f"--stage = {args.stage}: {args.scene} has {count} stage(s); give 1..{count}"
         )
-    if not (math.isfinite(args.load) and args.load >= 0):
-        return usage_error("mesh", f"--load = {args.load!r}: give a fraction >= 0 of the rated force")
+    if not (math.isfinite(args.load) and 0 <= args.load <= MAX_LOAD_FRACTION):
+        return usage_error(
+            "mesh", f"--load = {args.load!r}: give a fraction 0..{MAX_LOAD_FRACTION:g} of the rated force"
+        )
     stages = range(count) if args.stage is None else [args.stage - 1]
     with contextlib.ExitStack() as stack:
         if out is not None:  # locked while it writes; the old plots go first
