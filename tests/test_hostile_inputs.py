@@ -573,3 +573,13 @@ def test_a_run_refused_by_the_mode_check_leaves_no_folder(tmp_path, capsys):
 def test_study_values_nested_too_deep_are_refused_naming_the_option(tmp_path, capsys, argv, named):
     line = _one_line_refusal(capsys, [*argv, "--out", str(tmp_path / "study")], "more than 32 levels deep")
     assert named in line and "--set" not in line
+
+
+def test_an_integrator_exudyn_names_but_does_not_implement_is_refused(tmp_path, capsys):
+    """DVERK6 is in Exudyn's DynamicSolverType but its explicit solver raised NotImplementedFeatureError
+    at the first step, which read as a numerical failure with a tolerance hint."""
+    args = ["run", "one-stage", "--set", "solver.method=DVERK6", "--t-end", "0.01", "--no-plots"]
+    assert main([*args, "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert "solver.method = 'DVERK6'" in err and "'RK67'" in err
+    assert not (tmp_path / "r").exists()

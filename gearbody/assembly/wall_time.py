@@ -58,21 +58,21 @@ ATTEMPTS_PER_MESH_PERIOD = 105.0
 ATTEMPTS_PER_RATE_HZ = 45.0
 """Step attempts per simulated second per Hz of the fastest coordinate's rate, at the default
 tolerance."""
-TOLERANCE_EXPONENT = {"DOPRI5": 0.15, "ODE23": 0.28, "DVERK6": 0.15}
+TOLERANCE_EXPONENT = {"DOPRI5": 0.15, "ODE23": 0.28}
 """Attempts grow as (atol / default atol) ** -exponent (one-stage: x2 per 100x tighter with DOPRI5;
 ODE23 x9 from 3e-5 to 1e-8)."""
-REFERENCE_TOLERANCE = {"DOPRI5": 1.0, "ODE23": 3e3, "DVERK6": 1.0}
+REFERENCE_TOLERANCE = {"DOPRI5": 1.0, "ODE23": 3e3}
 """The atol, relative to the topology's default one, at which a method takes the attempts above scaled
 by REFERENCE_ATTEMPTS."""
-REFERENCE_ATTEMPTS = {"DOPRI5": 1.0, "ODE23": 0.53, "DVERK6": 1.0}
+REFERENCE_ATTEMPTS = {"DOPRI5": 1.0, "ODE23": 0.53}
 """Attempts of a method at its reference tolerance relative to DOPRI5 at the default one (ODE23 at the
 draft level: 0.36-0.87 on the scenes, 0.53 typical)."""
 FIXED_STEP_METHODS = ("RK44", "RK67")
 """Methods that take fixed steps of max_step_s (no error control in Exudyn)."""
-EVALUATIONS_PER_ATTEMPT = {"DOPRI5": 6, "ODE23": 3, "RK44": 5, "RK67": 10, "DVERK6": 8}
+EVALUATIONS_PER_ATTEMPT = {"DOPRI5": 6, "ODE23": 3, "RK44": 5, "RK67": 10}
 """Right-hand sides per step attempt (DOPRI5, ODE23: first-same-as-last saved); for RK44 and RK67 the
 cost of a step in evaluations' worth (their CPU time per step on one-stage and lateral-8dof is
-1.0-1.8x this). Exudyn 1.13.6 does not implement DVERK6 (such a run fails at its start)."""
+1.0-1.8x this)."""
 US_PER_EVALUATION_PER_COORDINATE = 0.5
 MIN_US_PER_EVALUATION = 1.5
 US_PER_EVALUATION_PER_LATERAL_GEAR = 1.2

@@ -26,15 +26,14 @@ from ..assembly.compound import compound_initial_state, compound_layout
 from ..errors import GearbodyError, SimulationError
 from ..model import Scenario
 from ..model.budget import memory_limit_bytes
+from ..model.scenario import SOLVER_METHODS
 from ..result import Result
 from .build import BuiltSystem, build_muller, build_torsional
 from .collect import collect
 from .compound import build_compound
 from .hints import divergence_hint, mesh_range_hint, stall_hint
 
-SOLVER_TYPES = {
-    name: getattr(exu.DynamicSolverType, name) for name in ("DOPRI5", "ODE23", "RK44", "RK67", "DVERK6")
-}
+SOLVER_TYPES = {name: getattr(exu.DynamicSolverType, name) for name in SOLVER_METHODS}
 # Exudyn 1.13's explicit step control accepts a step at the minimum step size only once per run
 # (CSolverExplicit.cpp: `if (hNew == hMin && !minStepSizeWarned)`), and rejects it forever after.
 # Jumps of k_z and of the contact damping are therefore crossed by error control alone, with a
