@@ -77,7 +77,7 @@ def _start(argv: list[str], out: Path) -> subprocess.Popen:
             [sys.executable, "-m", "gearbody.cli", *argv, "--out", str(out)],
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
-            env={**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"},
+            env={**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg", "PYTHONFAULTHANDLER": "1"},
             start_new_session=True,
         )
     finally:
@@ -142,6 +142,29 @@ def _under_way(command: str, process: str, proc: subprocess.Popen, out: Path, se
     return _records(command, out) >= 1 and bool(_workers(proc))
 
 
+def _state(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return "gone"
+
+
+def _stuck(proc: subprocess.Popen, pids: set[int]) -> str:
+    """What holds a command that has not ended 3 minutes after its signal: the state of its main
+    process and of every process seen, and the main process's Python stacks (faulthandler, on
+    SIGABRT) if it is still there."""
+    seen = {p: _state(p) for p in sorted({proc.pid, *pids, *_children(proc.pid)})}
+    text = f"not ended; process states {seen}"
+    if proc.poll() is None:
+        os.kill(proc.pid, signal.SIGABRT)
+        try:
+            _, err = proc.communicate(timeout=10)
+            text += "\n" + err.decode(errors="replace")[-4000:]
+        except subprocess.TimeoutExpired:
+            pass
+    return text
+
+
 def _interrupt(command: str, process: str, sig: str, out: Path) -> tuple[int, str, list[int]]:
     """Start the command, send the signal once it is under way; (exit code, stderr, pids seen)."""
     proc = _start(COMMANDS[command], out)
@@ -163,7 +186,10 @@ def _interrupt(command: str, process: str, sig: str, out: Path) -> tuple[int, st
             pids |= set(_workers(proc))
             time.sleep(0.02)
         os.set_blocking(proc.stderr.fileno(), True)
-        _, rest = proc.communicate(timeout=60)
+        try:
+            _, rest = proc.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            raise AssertionError(f"{sig} to the {process}: {_stuck(proc, pids)}") from None
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
