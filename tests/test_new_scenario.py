@@ -136,3 +136,15 @@ def test_the_default_file_is_named_after_the_scene_in_the_current_folder(tmp_pat
     monkeypatch.chdir(tmp_path)
     assert main(["new", "muller"]) == 0
     assert load_scenario(tmp_path / "muller.toml").meta.name == "muller"
+
+
+@pytest.mark.parametrize("where", ["file", "folder"])
+def test_a_name_too_long_for_the_file_system_is_refused_naming_its_length(tmp_path, capsys, where):
+    """300 bytes, beyond NAME_MAX (255 on common file systems): refused as input (exit 2) like run's
+    --out, not a write failure (exit 1) whose message was only the system's 'File name too long'."""
+    long = "y" * 300
+    out = tmp_path / long if where == "file" else tmp_path / long / "drive.toml"
+    assert main(["new", "two-wheel", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "300 bytes" in err and "give a shorter name" in err
+    assert list(tmp_path.iterdir()) == []

@@ -8,6 +8,7 @@ default or computed it (:mod:`gearbody.model.template`). ``gearbody run FILE`` t
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -92,6 +93,13 @@ def execute(args) -> int:
     if str(out) == "-":
         sys.stdout.write(document)
         return EXIT_OK
+    name_max = _name_max(out.parent)
+    for part in out.parts:
+        if len(os.fsencode(part)) > name_max:
+            raise InputError(
+                f"--out {out}: a name in it has {len(os.fsencode(part))} bytes, more than the "
+                f"{name_max} this file system allows; give a shorter name"
+            )
     if out.is_dir():
         raise InputError(f"--out {out}: is a folder, not a file")
     if out.exists() and not args.overwrite:
@@ -103,3 +111,14 @@ def execute(args) -> int:
     write_text(out, document)  # atomic: a full disk leaves FILE as it was (OutputError naming it)
     print(f"wrote {out}: {scenario.meta.name} with every key commented; run it with: gearbody run {out}")
     return EXIT_OK
+
+
+def _name_max(folder: Path) -> int:
+    """The longest file name, in bytes, that ``folder``'s file system (or that of its nearest existing
+    parent) takes; 255 where it cannot say."""
+    try:
+        while not folder.exists() and folder.parent != folder:
+            folder = folder.parent
+        return int(os.pathconf(folder, "PC_NAME_MAX"))
+    except (OSError, ValueError, AttributeError):
+        return 255
