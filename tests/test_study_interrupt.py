@@ -115,6 +115,60 @@ def test_a_dead_pool_worker_fails_only_its_own_job_and_the_pool_restarts():
     assert all(o["ok"] and o["value"] == dict(jobs)[jid][0] for jid, o in ok.items())
 
 
+def _nap(seconds: float) -> dict:
+    time.sleep(seconds)
+    return {"ok": True, "pid": os.getpid()}
+
+
+def test_a_pool_shutdown_that_sticks_is_bounded_and_its_workers_killed(monkeypatch):
+    """Python 3.11's pool can deadlock in the shutdown after its workers were stopped (gh-125451): the
+    study goes on after SHUTDOWN_GRACE_S, with the workers killed and the stuck pool noted."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    monkeypatch.setattr(executors, "SHUTDOWN_GRACE_S", 0.5)
+    monkeypatch.setattr(executors, "STUCK_POOLS", [])
+    release = threading.Event()
+    real = ProcessPoolExecutor.shutdown
+
+    def stuck(self, wait=True, *, cancel_futures=False):
+        if threading.current_thread().name == "gearbody-pool-stop":
+            release.wait(60)  # as the deadlocked manager thread would hold it
+        return real(self, wait=wait, cancel_futures=cancel_futures)
+
+    monkeypatch.setattr(ProcessPoolExecutor, "shutdown", stuck)
+    jobs = [("quick", (0.0,)), ("slow", (60.0,))]
+    pool = executors.run_pool(_nap, jobs, workers=2)
+    jid, outcome = next(pool)
+    assert jid == "quick" and outcome["ok"]
+    t0 = time.monotonic()
+    pool.close()  # closed early: the slow job's worker is stopped, the shutdown sticks
+    try:
+        assert time.monotonic() - t0 < 10
+        assert executors.STUCK_POOLS == ["pool of 2 workers: shutdown still waiting after 0.5 s"]
+    finally:
+        release.set()
+
+
+def test_the_command_line_leaves_when_a_stuck_pool_would_hold_its_exit():
+    """A thread that never ends (as a deadlocked pool's manager thread) would keep the interpreter from
+    exiting: gearbody.cli.run leaves with the command's code, saying why."""
+    code = (
+        "import sys, threading\n"
+        "from gearbody.studies import executors\n"
+        "threading.Thread(target=threading.Event().wait).start()\n"
+        "executors.STUCK_POOLS.append('pool of 2 workers: shutdown still waiting')\n"
+        "sys.argv = ['gearbody', 'list']\n"
+        "from gearbody.cli import run\n"
+        "run()\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0
+    assert "one-stage" in done.stdout
+    assert done.stderr.strip().splitlines() == [
+        "gearbody: pool of 2 workers: shutdown still waiting; leaving without waiting for it"
+    ]
+
+
 def test_death_causes_name_the_signal_or_the_exit_code():
     assert executors.death_cause(-signal.SIGSEGV) == "worker process died (signal 11, SIGSEGV)"
     assert executors.death_cause(1) == "worker process exited with code 1"

@@ -21,6 +21,7 @@ Time: a run or study estimates its wall time before it starts (``--max-wall-minu
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 import threading
@@ -95,6 +96,21 @@ def _printable_paths() -> None:
             stream.reconfigure(errors="backslashreplace")
         except (AttributeError, ValueError):  # not a text stream of its own (a test's capture, closed)
             pass
+
+
+def run() -> None:
+    """The ``gearbody`` script and ``python -m gearbody.cli``: :func:`main`, then exit with its code. A
+    process pool whose shutdown stuck (gearbody.studies.executors.STUCK_POOLS) would hold the
+    interpreter's exit for ever: then the streams are flushed and the process leaves at once."""
+    code = main()
+    from gearbody.studies.executors import STUCK_POOLS
+
+    if STUCK_POOLS:
+        print(f"gearbody: {STUCK_POOLS[0]}; leaving without waiting for it", file=sys.stderr)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
 
 
 def main(argv: list[str] | None = None) -> int:

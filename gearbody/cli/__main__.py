@@ -1,7 +1,5 @@
 """``python -m gearbody.cli``: as the ``gearbody`` script."""
 
-import sys
+from gearbody.cli import run
 
-from gearbody.cli import main
-
-sys.exit(main())
+run()

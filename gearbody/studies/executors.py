@@ -201,6 +201,40 @@ def death_cause(exitcode: int | None) -> str:
     return f"worker process exited with code {exitcode}"
 
 
+SHUTDOWN_GRACE_S = 30.0
+"""How long a pool whose workers were stopped (interrupted, closed early, broken) may take to shut down.
+Python 3.11's ProcessPoolExecutor can deadlock in that shutdown (its manager thread joins the queue's
+feeder thread while holding the lock the feeder waits for: CPython gh-125451, fixed in 3.12.8 and
+3.13.1); an interrupted sweep on a busy machine once had not ended 3 minutes after Ctrl-C."""
+
+STUCK_POOLS: list[str] = []
+"""Pools whose shutdown did not end within SHUTDOWN_GRACE_S: their manager threads would hold the
+interpreter's exit for ever, so the command line leaves with ``os._exit`` (gearbody.cli.run)."""
+
+
+def _shutdown_stopped(pool: ProcessPoolExecutor, processes: list) -> None:
+    """Shut down a pool whose workers were told to stop, within SHUTDOWN_GRACE_S: a worker still alive
+    then is killed, and a shutdown that is still stuck is left to a daemon thread (noted in
+    STUCK_POOLS)."""
+    stopper = threading.Thread(
+        target=pool.shutdown,
+        kwargs={"wait": True, "cancel_futures": True},
+        name="gearbody-pool-stop",
+        daemon=True,
+    )
+    stopper.start()
+    stopper.join(SHUTDOWN_GRACE_S)
+    if not stopper.is_alive():
+        return
+    for p in processes:
+        if p.is_alive():
+            p.kill()
+            p.join(5.0)
+    STUCK_POOLS.append(
+        f"pool of {len(processes)} workers: shutdown still waiting after {SHUTDOWN_GRACE_S:g} s"
+    )
+
+
 def _pool_processes(pool: ProcessPoolExecutor) -> list:
     """The pool's worker processes (none once a broken pool has let go of them)."""
     return list((getattr(pool, "_processes", None) or {}).values())
@@ -246,11 +280,13 @@ def run_pool(
                     yield futures[fut], outcome
                 done = not broken
             finally:
-                if not done:  # interrupted, closed early or broken: stop every worker now
+                if done:
+                    pool.shutdown(wait=True, cancel_futures=True)
+                else:  # interrupted, closed early or broken: stop every worker now
                     processes = processes or _pool_processes(pool)
                     for p in processes:
                         p.terminate()
-                pool.shutdown(wait=True, cancel_futures=True)
+                    _shutdown_stopped(pool, processes)
             if not broken:
                 continue
             for fut, jid in futures.items():  # finished before the break but not yielded yet
