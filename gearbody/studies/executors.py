@@ -204,8 +204,8 @@ def death_cause(exitcode: int | None) -> str:
 SHUTDOWN_GRACE_S = 30.0
 """How long a pool whose workers were stopped (interrupted, closed early, broken) may take to shut down.
 Python 3.11's ProcessPoolExecutor can deadlock in that shutdown (its manager thread joins the queue's
-feeder thread while holding the lock the feeder waits for: CPython gh-125451, fixed in 3.12.8 and
-3.13.1); an interrupted sweep on a busy machine once had not ended 3 minutes after Ctrl-C."""
+feeder thread while holding the lock the feeder waits for: CPython gh-125451, fixed in later 3.12 and
+3.13 releases); an interrupted sweep on a busy machine once had not ended 3 minutes after Ctrl-C."""
 
 STUCK_POOLS: list[str] = []
 """Pools whose shutdown did not end within SHUTDOWN_GRACE_S: their manager threads would hold the
