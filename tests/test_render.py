@@ -1,5 +1,13 @@
 """Headless pictures of a simulated drive (Exudyn's software raytracer, no display)."""
 
+import contextlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -193,3 +201,42 @@ def test_the_mesh_frame_is_centred_on_the_pitch_point_and_shows_both_gears_teeth
     col = img[:, W // 2].astype(int)
     changes = np.count_nonzero(np.abs(np.diff(col, axis=0)).sum(axis=1) > 60)
     assert changes >= 4
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the parent-death signal is Linux's")
+def test_a_render_killed_while_it_encodes_leaves_no_encoder_running(tmp_path):
+    """SIGKILL to gearbody while ffmpeg encodes its MP4: the encoder dies with it (a fake ffmpeg on PATH
+    that waits; the real one would be left running, writing a movie nobody reads)."""
+    fake = tmp_path / "bin" / "ffmpeg"
+    fake.parent.mkdir()
+    pid_file = tmp_path / "ffmpeg.pid"
+    fake.write_text(f'#!/bin/sh\necho $$ > "{pid_file}"\nexec sleep 120\n')
+    fake.chmod(0o755)
+    env = {**os.environ, "PATH": f"{fake.parent}{os.pathsep}{os.environ['PATH']}", "MPLBACKEND": "Agg"}
+    args = ["render", "one-stage", "--kinematic", "--frames", "2", "--format", "mp4", "--width", "32"]
+    args += ["--height", "24", "--quiet", "--out", str(tmp_path / "out")]
+    proc = subprocess.Popen([sys.executable, "-m", "gearbody.cli", *args], env=env, start_new_session=True)
+    try:
+        t0 = time.monotonic()
+        while not (pid_file.exists() and pid_file.read_text().strip()):
+            assert proc.poll() is None and time.monotonic() - t0 < 120, "the encoder never started"
+            time.sleep(0.05)
+        encoder = int(pid_file.read_text())
+        proc.kill()
+        proc.wait()
+        t0 = time.monotonic()
+        while _alive(encoder) and time.monotonic() - t0 < 10:
+            time.sleep(0.05)
+        assert not _alive(encoder), "the encoder outlived the render"
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+        with contextlib.suppress(OSError, ValueError):
+            os.kill(int(pid_file.read_text()), signal.SIGKILL)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False

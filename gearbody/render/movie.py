@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import ctypes
 import errno
 import shutil
+import signal
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -52,6 +55,15 @@ def ffmpeg_available() -> bool:
     return shutil.which("ffmpeg") is not None
 
 
+def _die_with_parent() -> None:
+    """The encoder's ``preexec_fn`` on Linux: SIGTERM to it when the process that started it dies
+    (``prctl(PR_SET_PDEATHSIG)``), so a render killed with SIGKILL leaves no ffmpeg running."""
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM), 0, 0, 0)  # 1: PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
 def write_mp4(frame_pattern: Path, path: Path, fps: float) -> Path:
     """H.264 MP4 from numbered PNG frames (needs ffmpeg on PATH)."""
     if not ffmpeg_available():
@@ -74,7 +86,10 @@ def write_mp4(frame_pattern: Path, path: Path, fps: float) -> Path:
     ]
 
     def encode(tmp: Path) -> None:
-        done = subprocess.run([*cmd, str(tmp)], capture_output=True, text=True)
+        linux = sys.platform.startswith("linux")
+        done = subprocess.run(
+            [*cmd, str(tmp)], capture_output=True, text=True, preexec_fn=_die_with_parent if linux else None
+        )
         if "No space left on device" in done.stderr:
             raise OSError(errno.ENOSPC, "No space left on device", str(tmp))
         if done.returncode != 0:
