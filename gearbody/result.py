@@ -17,6 +17,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .errors import SignalError, StageError
+from .signals import gear_names, stage_prefix, stage_signal
 
 FINAL_FRACTION = 0.25
 """Share of the run, at its end, over which 'final' values are taken (the steady period)."""
@@ -137,10 +138,10 @@ class Result:
         self._stage(stage)
         if stage == 0:
             return self[name]
-        for gear in ("pinion", "wheel"):
+        for gear, named in zip(("pinion", "wheel"), gear_names(stage), strict=True):
             if name.startswith(gear + "_"):
-                return self[f"{gear}_{stage + 1}_{name[len(gear) + 1 :]}"]
-        return self[f"stage_{stage + 1}_{name}"]
+                return self[f"{named}_{name[len(gear) + 1 :]}"]
+        return self[stage_signal(name, stage)]
 
     FINAL_FRACTION = FINAL_FRACTION
 
@@ -215,11 +216,7 @@ class Result:
         from .analysis import KinematicSources, amplitude_spectrum, kinematic_lines, label_peaks
 
         name = signal or self.vibration_signal_name
-        ring = [
-            k
-            for k in self.planetary_stages
-            if name == ("" if k == 0 else f"stage_{k + 1}_") + "ring_sensor_N"
-        ]
+        ring = [k for k in self.planetary_stages if name == stage_signal("ring_sensor_N", k)]
         if ring:  # a planetary stage's ring sensor: the spectrum of its run plot and report
             from .plotting.planetary import ring_sensor_spectrum
 
@@ -437,7 +434,7 @@ class Result:
             }
         )
         for k, meta in enumerate(self.meta["stages"]):
-            prefix = "" if k == 0 else f"stage_{k + 1}_"
+            prefix = stage_prefix(k)
             if meta.get("type") != "planetary":
                 if k > 0:
                     kd = self[prefix + "kd"]

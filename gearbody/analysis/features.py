@@ -46,6 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from gearbody.errors import InputError
 
+from ..signals import stage_signal
 from .dynamic_factor import separation_stats
 from .indicators import condition_indicators_from_average, rms
 from .spectrum import amplitude_spectrum, peak_near
@@ -334,7 +335,7 @@ def _option_value(text: str, key: str, value: str, name: str = "") -> float | st
 def _stage_name(name: str, stage: int) -> str:
     if stage < 1:
         raise FeatureError(f"stage = {stage}: stages count from 1")
-    return name if stage == 1 else f"stage_{stage}_{name}"
+    return stage_signal(name, stage - 1)
 
 
 def _mesh_signals(spec: FeatureSpec, record: Record, quantity: str) -> tuple[str, ...]:

@@ -23,6 +23,7 @@ from ..model import Scenario
 from ..model.planetary import PlanetaryStage
 from ..physics.mesh import I_LU, I_MU
 from ..physics.planetary_mesh import G_BEARING_K, G_DELTA0_RING, G_DELTA0_SUN, stage_forces
+from ..signals import stage_prefix
 from .operating_point import static_deflection_m, steady_operating_point
 from .parameters import mesh_parameters_from_scenario, pack_drive_parameters
 from .planetary_layout import CENTRAL, PlanetaryLayout, layout_from_stage
@@ -38,7 +39,6 @@ __all__ = [
     "has_bearing_laws",
     "stage_stiffness_matrix",
     "planetary_member_names",
-    "stage_prefix",
 ]
 
 
@@ -49,11 +49,6 @@ LAW_NEWTON_ITERATIONS = 300
 STATIC_TOLERANCE = 1e-9
 """Largest residual force of the static start, relative to the stage's largest external torque (N or
 N m per N m)."""
-
-
-def stage_prefix(stage: int) -> str:
-    """Signal and coordinate prefix of a stage: none for the first, ``stage_<s>_`` after."""
-    return "" if stage == 0 else f"stage_{stage + 1}_"
 
 
 def planetary_member_names(stage: int, planets: int) -> tuple[str, ...]:

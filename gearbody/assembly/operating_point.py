@@ -16,6 +16,7 @@ from ..model.planetary import PlanetaryStage
 from ..physics.lateral import mesh_directions, static_bearing_displacement_m
 from ..physics.mesh import effective_stiffness_series, pair_in_mesh
 from ..physics.motor import steady_slip
+from ..signals import stage_prefix
 from .parameters import mesh_parameters_from_scenario
 from .topology import gear_names
 
@@ -154,7 +155,7 @@ def nominal_speeds_rad_s(scenario: Scenario) -> dict[str, float]:
     out = {"motor": w} if scenario.meta.topology == "train" else {}
     for k, st in enumerate(scenario.stages):
         if isinstance(st, PlanetaryStage):
-            prefix = "" if k == 0 else f"stage_{k + 1}_"
+            prefix = stage_prefix(k)
             willis = st.speeds(w)
             for member in ("sun", "ring", "carrier"):
                 out[prefix + member] = st.input_sense * willis.of(member)

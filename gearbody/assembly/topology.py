@@ -13,6 +13,7 @@ import numpy as np
 
 from ..model import Scenario
 from ..physics.lateral import mesh_directions
+from ..signals import gear_names
 from .parameters import mesh_parameters_from_scenario, pack_drive_parameters
 
 
@@ -73,11 +74,6 @@ class TorsionalLayout:
     @property
     def is_lateral(self) -> bool:
         return any(b.lateral is not None for b in self.inertias)
-
-
-def gear_names(stage: int) -> tuple[str, str]:
-    """Names of a stage's gears: ``pinion``/``wheel`` for the first, ``pinion_2``/``wheel_2``... after."""
-    return ("pinion", "wheel") if stage == 0 else (f"pinion_{stage + 1}", f"wheel_{stage + 1}")
 
 
 def torsional_layout(scenario: Scenario) -> TorsionalLayout:

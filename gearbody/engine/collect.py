@@ -22,6 +22,7 @@ from ..physics.bearings import LinearBearing
 from ..physics.lateral import mesh_directions
 from ..physics.mesh import mesh_contact_series, mesh_phase_series
 from ..result import Result
+from ..signals import stage_prefix
 from ..version import __version__
 from .build import BuiltSystem
 from .planetary_signals import planetary_jump_times, planetary_signals, stage_input_name
@@ -179,7 +180,7 @@ def _band_limited_signals(scenario, names, t_fine, q, v, a, M=OVERSAMPLING) -> d
     t = t_fine[::M]
     jumps = []
     for k, st in enumerate(scenario.stages):
-        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        prefix = stage_prefix(k)
         if isinstance(st, PlanetaryStage):
             jumps += planetary_jump_times(scenario, k, names, t_fine, q, v)
             continue
@@ -265,7 +266,7 @@ def _torsional_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> di
                 sliding = sliding + sign * (v[ix] * m[0] + v[iy] * m[1])
         sig = _mesh_signals(q[ip], delta, rate, scenario.stage_rated_force_N(k), P, (v[ip], v[iw]), sliding)
         sig["mesh_frequency_hz"] = st.pinion.teeth * v[ip] / (2 * math.pi)
-        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        prefix = stage_prefix(k)
         out.update({prefix + key: value for key, value in sig.items()})
     if drive_torques:
         out.update(_drive_torques(scenario, t, v[0]))
@@ -277,7 +278,7 @@ def _lateral_signals(scenario, names, q, v, a, signals) -> dict[str, np.ndarray]
     (docs/scenario.md, 'Signals'): a fixed direction passes the mesh force component on."""
     out = {}
     for k, st in enumerate(scenario.stages):  # lateral gears are never combined with planetary stages
-        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        prefix = stage_prefix(k)
         F, T = signals[prefix + "mesh_force_N"], signals[prefix + "friction_force_N"]
         n, m, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
         for name, gear, sign in zip(gear_names(k), (st.pinion, st.wheel), (1.0, -1.0), strict=True):

@@ -17,6 +17,7 @@ from ..model import Scenario
 from ..model.planetary import PlanetaryStage
 from ..physics.mesh import mesh_phase_series
 from ..physics.planetary_mesh import stage_contact_series, stage_mesh_series
+from ..signals import gear_names, stage_prefix
 from .sampling import mesh_jump_times
 
 __all__ = ["planetary_jump_times", "planetary_signals", "stage_input_name"]
@@ -25,10 +26,10 @@ __all__ = ["planetary_jump_times", "planetary_signals", "stage_input_name"]
 def stage_input_name(scenario: Scenario, k: int) -> str:
     """The coordinate name of stage k's input rotation (pinion, or the planetary input member)."""
     st = scenario.stages[k]
-    prefix = "" if k == 0 else f"stage_{k + 1}_"
+    prefix = stage_prefix(k)
     if isinstance(st, PlanetaryStage):
         return prefix + st.input
-    return "pinion" if k == 0 else f"pinion_{k + 1}"
+    return gear_names(k)[0]
 
 
 def _links(scenario: Scenario) -> tuple[PlanetaryLink, ...]:
@@ -49,7 +50,7 @@ def planetary_signals(scenario: Scenario, names: list[str], q, v, a) -> dict[str
     out: dict[str, np.ndarray] = {}
     for link in _links(scenario):
         k, st = link.stage, scenario.stages[link.stage]
-        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        prefix = stage_prefix(k)
         absolute, rate, G = _stage_coordinates(link, names, q, v)
         states = stage_mesh_series(absolute, rate, G)  # law angle, deflection, rate per mesh
         contacts = stage_contact_series(absolute, rate, G, *link.layout.mesh_arrays())  # F, T, v_T

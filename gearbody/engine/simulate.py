@@ -28,6 +28,7 @@ from ..model import Scenario
 from ..model.budget import memory_limit_bytes
 from ..model.scenario import SOLVER_METHODS
 from ..result import Result
+from ..signals import stage_prefix
 from .build import BuiltSystem, build_muller, build_torsional
 from .collect import collect
 from .compound import build_compound
@@ -165,7 +166,7 @@ def _check_mesh_range(scenario: Scenario, result: Result) -> None:
         if not hasattr(st, "pinion"):
             _check_planetary_mesh_range(k, st, result)
             continue
-        prefix = "" if k == 0 else f"stage_{k + 1}_"
+        prefix = stage_prefix(k)
         delta = np.abs(result[prefix + "mesh_deflection_m"])
         p_b = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
         if delta.max() > MAX_DEFLECTION_BASE_PITCH * p_b:
@@ -181,7 +182,7 @@ def _check_mesh_range(scenario: Scenario, result: Result) -> None:
 
 def _check_planetary_mesh_range(k: int, st, result: Result) -> None:
     """Every planet mesh of planetary stage k within MAX_DEFLECTION_BASE_PITCH of the base pitch."""
-    prefix = "" if k == 0 else f"stage_{k + 1}_"
+    prefix = stage_prefix(k)
     p_b = math.pi * st.module_mm * 1e-3 * math.cos(math.radians(st.pressure_angle_deg))
     limit = MAX_DEFLECTION_BASE_PITCH * p_b
     for n in range(st.planets):

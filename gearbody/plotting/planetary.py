@@ -25,6 +25,7 @@ from gearbody.analysis.planetary_lines import (
 )
 from gearbody.analysis.spectrum import Spectrum
 
+from ..signals import stage_file_tag, stage_prefix
 from .figure import new_figure, save_figure, set_title
 from .result import plot_signals
 from .spectrum import plot_labelled_spectrum
@@ -49,15 +50,11 @@ CANCELLED_CAPTION = (
 )
 
 
-def _prefix(stage: int) -> str:
-    return "" if stage == 0 else f"stage_{stage + 1}_"
-
-
 def planetary_sources(result: Result, stage: int, mask: np.ndarray | None = None) -> PlanetarySources:
     """The stage's teeth, planets and mean member speeds (Hz, signed) over ``mask`` (default: the final
     window, :meth:`Result.final_window`)."""
     meta = result.meta["stages"][stage]
-    prefix = _prefix(stage)
+    prefix = stage_prefix(stage)
     win = result.final_window() if mask is None else mask
     hz = {
         m: float(np.mean(result[f"{prefix}{m}_speed_rad_s"][win])) / (2 * np.pi)
@@ -99,7 +96,7 @@ def ring_sensor_window(result: Result, stage: int) -> CarrierWindow:
     """The analysis window of the stage's ring sensor: the whole carrier revolutions (relative to the
     ring) of the second half of the time after the run's last change of speed or load
     (:func:`gearbody.analysis.carrier_window.carrier_window`)."""
-    prefix = _prefix(stage)
+    prefix = stage_prefix(stage)
     carrier = result[f"{prefix}carrier_angle_rad"] - result[f"{prefix}ring_angle_rad"]
     return carrier_window(result.time_s, carrier, change_s=last_change_s(result))
 
@@ -137,7 +134,7 @@ def ring_sensor_spectrum(result: Result, stage: int) -> RingSensorSpectrum:
     """The stage's ring sensor over :func:`ring_sensor_window`: its spectrum (order-tracked over whole
     carrier revolutions, read in Hz) and the stage's lines at the window's mean speeds, 3 mesh harmonics,
     cancelled lines marked when the planets are equally spaced."""
-    prefix = _prefix(stage)
+    prefix = stage_prefix(stage)
     name = f"{prefix}ring_sensor_N"
     window = ring_sensor_window(result, stage)
     carrier = result[f"{prefix}carrier_angle_rad"] - result[f"{prefix}ring_angle_rad"]
@@ -171,8 +168,8 @@ def write_planetary_plots(result: Result, out_dir: str | Path) -> list[Path]:
     for k, meta in enumerate(result.meta["stages"]):
         if meta.get("type") != "planetary":
             continue
-        prefix = "" if k == 0 else f"stage_{k + 1}_"
-        tag = "" if k == 0 else f"_stage_{k + 1}"
+        prefix = stage_prefix(k)
+        tag = stage_file_tag(k)
         n = meta["planets"]
         kd = {
             f"planet {p} {mesh}": result[f"{prefix}planet_{p}_{mesh}_mesh_kd"]

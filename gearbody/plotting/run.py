@@ -11,6 +11,8 @@ import numpy as np
 
 from gearbody.analysis import amplitude_spectrum, fold_over_mesh_period
 
+from ..signals import stage_file_tag
+
 if TYPE_CHECKING:  # Result.plot() calls this module
     from gearbody.result import Result
 
@@ -30,7 +32,7 @@ def parallel_stage_plot_names(result: Result) -> list[str]:
     names = []
     for k in range(result.n_stages):
         if result.stage_kind(k) == "parallel":
-            tag = "" if k == 0 else f"_stage_{k + 1}"
+            tag = stage_file_tag(k)
             names += [f"kd_time{tag}.png", f"kd_folded{tag}.png"]
     return names
 
@@ -69,7 +71,7 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
 
 def _stage_kd_plots(result: Result, stage: int, out: Path, title: str) -> list[Path]:
     """K_d of parallel stage ``stage`` (0-based) over time and folded over its mesh period."""
-    tag = "" if stage == 0 else f"_stage_{stage + 1}"
+    tag = stage_file_tag(stage)
     which = f", stage {stage + 1}" if result.n_stages > 1 else ""
     kd = result.stage_signal("kd", stage)
     paths = [

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from ..model import Scenario
 from ..model.planetary import PlanetaryStage
 from ..physics.lateral import mesh_directions
+from ..signals import gear_names, stage_prefix
 from .shapes import (  # noqa: F401  (the parts are re-exported: render code and tests import them here)
     BASE,
     BEARING,
@@ -216,13 +217,13 @@ def build_layout(scenario: Scenario) -> Layout:
         )
         axes.append((axes[-1][0] + a * math.cos(gam), axes[-1][1] + a * math.sin(gam)))
     senses, mirrors = _axis_senses(stages)
-    names = [("pinion", "wheel")] + [(f"pinion_{k + 1}", f"wheel_{k + 1}") for k in range(1, len(stages))]
+    names = [gear_names(k) for k in range(len(stages))]
     # the bodies on each stage's input and output shaft, and their model angle per unit chain angle
     # (a planetary member's angle is absolute, counter-clockwise: s_in or s_out times the chain's)
     ends = []
     for k, st in enumerate(stages):
         if planetary[k]:
-            p = "" if k == 0 else f"stage_{k + 1}_"
+            p = stage_prefix(k)
             ends.append((p + st.input, st.input_sense, p + st.output, st.output_sense))
         else:
             ends.append((names[k][0], 1, names[k][1], 1))

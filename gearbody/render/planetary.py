@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from ..model.planetary import PlanetaryStage
+from ..signals import stage_prefix
 from .shapes import MARKER, STEEL, WHEEL, Body, Cylinder, GearShape, Orbit, Prism
 
 RING = (0.5, 0.52, 0.56, 1.0)
@@ -162,7 +163,7 @@ def stage_bodies(
     """
     g = st.geometry
     m, b = g.module_m, face_m
-    prefix = "" if stage == 0 else f"stage_{stage + 1}_"
+    prefix = stage_prefix(stage)
     psis = [mirror * a for a in g.planet_angles_rad]
     r_s, r_p, r_r, r_c = (
         g.sun_pitch_radius_m,

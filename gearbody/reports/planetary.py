@@ -23,6 +23,8 @@ from gearbody.plotting.planetary import equally_spaced, ring_sensor_spectrum
 from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure, tsa_figure
 from gearbody.result import Result
 
+from ..signals import stage_prefix
+
 __all__ = ["planetary_report_sections"]
 
 MIN_TSA_REVOLUTIONS = 2
@@ -32,7 +34,7 @@ def planetary_report_sections(result: Result) -> dict[str, Any]:
     """summary, signal, unit, peaks, indicators, figures (base64 PNG), the analysed window ("window") and,
     when it cannot resolve the carrier sidebands, a note ("window_note") of a planetary run."""
     k = result.planetary_stages[0]
-    prefix = "" if k == 0 else f"stage_{k + 1}_"
+    prefix = stage_prefix(k)
     meta = result.meta["stages"][k]
     ring = ring_sensor_spectrum(result, k)
     win = ring.window.mask(result.time_s.size)
