@@ -323,11 +323,13 @@ class Result:
     def summary(self) -> dict[str, Any]:
         """What a diagnostician reads first (the values of summary.json): K_d over the run and over its
         final quarter (the steady, rated-load period of the four-period runs), separation, mesh frequency,
-        speed, solver statistics and bearing forces; whole-run values say so by having no '_final'."""
+        speed, solver statistics and bearing forces; whole-run values say so by having no '_final'. Last,
+        ``sources``: where the scene's parameter values come from (``meta.sources``)."""
         from .analysis import separation_stats
 
+        sources = {"sources": list(self.meta.get("sources") or [])}
         if self.planetary_stages:
-            return {**self._planetary_summary(), **self._direction_summary()}
+            return {**self._planetary_summary(), **self._direction_summary(), **sources}
         win = self.final_window()
         sep = separation_stats(self.mesh_force, self.time_s, kd=self.kd)
         speed = (
@@ -370,6 +372,7 @@ class Result:
                 for axis in "xy"
             },
             **self._direction_summary(),
+            **sources,
         }
 
     def rotation_directions(self):

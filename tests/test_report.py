@@ -1,5 +1,6 @@
 """The HTML report and the resonance tools (issue 4, items 3 and 5)."""
 
+import html
 import math
 
 import numpy as np
@@ -103,3 +104,19 @@ def test_the_strongest_kinematic_lines_are_named():
     assert all(p.explained for p in strongest), [(p.frequency_hz, p.label) for p in strongest]
     labels = " | ".join(p.label for p in strongest)
     assert "f_z1 + 4 f_pinion" in labels and "2 f_z1 - 9 f_pinion" in labels and "12x pinion" in labels
+
+
+@pytest.mark.parametrize("scene", ["one-stage", "planetary"])
+def test_the_scenes_sources_travel_into_the_summary_and_the_report(scene, tmp_path):
+    """Where the parameter values come from (the scene's meta.sources) is in summary.json and the report,
+    for a parallel and a planetary drive; a scene without sources says so."""
+    scenario = load_scenario(scene, ["operation.t_end_s=0.01"])
+    assert scenario.meta.sources
+    result = simulate(scenario)
+    assert result.summary()["sources"] == list(scenario.meta.sources)
+    text = write_report(result, tmp_path / "report.html").read_text()
+    assert "<h2>Sources of the parameter values</h2>" in text
+    assert all(f"<li>{html.escape(src)}</li>" in text for src in scenario.meta.sources)
+    bare = simulate(scenario.replace(meta=scenario.meta.replace(sources=())))
+    assert bare.summary()["sources"] == []
+    assert "the scene names no sources" in write_report(bare, tmp_path / "bare.html").read_text()

@@ -151,7 +151,10 @@ def write_report(result: Result, path: str | Path) -> Path:
     cannot be written)."""
     s = report_sections(result)
     title = html.escape(str(result.meta.get("title", result.meta.get("scene", "gearbody run"))))
-    summary_rows = [{"quantity": k, "value": v} for k, v in s["summary"].items() if not isinstance(v, dict)]
+    summary_rows = [
+        {"quantity": k, "value": v} for k, v in s["summary"].items() if not isinstance(v, (dict, list))
+    ]
+    sources = [html.escape(str(src)) for src in s["summary"].get("sources") or []]
     fig = s["figures"]
     img = {k: f'<img src="data:image/png;base64,{v}" alt="{k}">' for k, v in fig.items()}
     parts = [
@@ -178,6 +181,10 @@ def write_report(result: Result, path: str | Path) -> Path:
         "<h2>Synchronous average and condition indicators</h2>",
         img.get("tsa", f"<p>{html.escape(s.get('tsa_note', ''))}</p>"),
         _table([{"indicator": k, "value": v} for k, v in s["indicators"].items()]),
+        "<h2>Sources of the parameter values</h2>",
+        "<ul>" + "".join(f"<li>{src}</li>" for src in sources) + "</ul>"
+        if sources
+        else "<p>the scene names no sources (<code>meta.sources</code>)</p>",
         "</body></html>",
     ]
     return write_text(Path(path), "\n".join(parts))  # atomic: a full disk leaves no part
