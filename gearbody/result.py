@@ -201,7 +201,7 @@ class Result:
     def spectrum(
         self,
         signal: str | None = None,
-        fraction: float = 0.25,
+        fraction: float = FINAL_FRACTION,
         harmonics: int = 6,
         sidebands: int = 3,
         min_prominence_db: float = 12.0,
@@ -209,11 +209,13 @@ class Result:
     ):
         """Labelled amplitude spectrum of ``signal`` (default: the vibration signal of the report) over the
         final ``fraction`` of the run: a :class:`LabelledSpectrum` with the spectrum and its peaks, each
-        labelled by the drive's shaft orders, mesh harmonics, sidebands and cross-modulation lines. A
+        labelled by the drive's shaft orders, mesh harmonics, sidebands and cross-modulation lines
+        (:func:`gearbody.analysis.gear_train_lines`). The report and the run's spectrum plot show this
+        spectrum, so a run is labelled the same everywhere. A
         planetary stage's ring sensor is read as in its run plot and report: order-tracked over the whole
         carrier revolutions of the run's steady part (``fraction`` does not apply), the lines the phasing
         rule cancels marked "(cancelled)" (docs/planetary-lines.md)."""
-        from .analysis import KinematicSources, amplitude_spectrum, kinematic_lines, label_peaks
+        from .analysis import amplitude_spectrum, gear_train_lines, label_peaks
 
         name = signal or self.vibration_signal_name
         ring = [k for k in self.planetary_stages if name == stage_signal("ring_sensor_N", k)]
@@ -245,8 +247,9 @@ class Result:
         if f_mesh > 0:
             f_max = min(f_max, (harmonics + 0.5) * f_mesh)
             teeth = [self.teeth(k) for k in range(self.n_stages)]
-            sources = KinematicSources.gear_train(f_mesh / teeth[0][0], teeth)
-            lines = kinematic_lines(sources, f_max, harmonics=harmonics, sidebands=sidebands, shaft_orders=30)
+            lines = gear_train_lines(
+                f_mesh / teeth[0][0], teeth, f_max, harmonics=harmonics, sidebands=sidebands
+            )
             peaks = label_peaks(
                 spec,
                 lines,

@@ -120,3 +120,25 @@ def test_the_scenes_sources_travel_into_the_summary_and_the_report(scene, tmp_pa
     bare = simulate(scenario.replace(meta=scenario.meta.replace(sources=())))
     assert bare.summary()["sources"] == []
     assert "the scene names no sources" in write_report(bare, tmp_path / "bare.html").read_text()
+
+
+@pytest.mark.parametrize("scene", ["one-stage", "two-stage"])
+def test_a_run_is_labelled_the_same_by_result_spectrum_the_report_and_the_plot(scene, tmp_path, monkeypatch):
+    """One labelled spectrum: the report's peaks and the run plot's spectrum are Result.spectrum()'s
+    (before issue 27 the report composed its own, with other lines and another f_max)."""
+    import gearbody.plotting.run as run_plots
+    from gearbody.analysis import peaks_to_rows
+
+    result = simulate(load_scenario(scene, [*steady_overrides(1.0, 0.3)]))
+    labelled = result.spectrum()
+    assert labelled.peaks and any(p.labels for p in labelled.peaks)
+    assert report_sections(result)["peaks"] == peaks_to_rows(labelled.peaks)
+    drawn = {}
+
+    def capture(spec, path, **kwargs):
+        drawn["spec"] = spec
+        return path
+
+    monkeypatch.setattr(run_plots, "plot_spectrum", capture)
+    run_plots._spectrum_plot(result, tmp_path, "run")
+    assert np.array_equal(drawn["spec"].amplitude, labelled.spectrum.amplitude)

@@ -26,7 +26,14 @@ from gearbody.analysis.indicators import (
     rms,
     sideband_energy_ratio,
 )
-from gearbody.analysis.kinematics import GearMesh, KinematicLine, KinematicSources, Shaft, kinematic_lines
+from gearbody.analysis.kinematics import (
+    GearMesh,
+    KinematicLine,
+    KinematicSources,
+    Shaft,
+    gear_train_lines,
+    kinematic_lines,
+)
 from gearbody.analysis.peak_report import peaks_table, peaks_to_rows
 from gearbody.analysis.peaks import LabelledPeak, label_peaks
 from gearbody.analysis.planet_pass import (
@@ -66,6 +73,7 @@ __all__ = [
     "RotationDirections",
     "rotation_directions",
     "Shaft",
+    "gear_train_lines",
     "kinematic_lines",
     "label_peaks",
     "peaks_table",

@@ -16,7 +16,15 @@ import numpy as np
 
 from gearbody.analysis._validate import integer_at_least, positive_frequency
 
-__all__ = ["Family", "GearMesh", "KinematicLine", "KinematicSources", "Shaft", "kinematic_lines"]
+__all__ = [
+    "Family",
+    "GearMesh",
+    "KinematicLine",
+    "KinematicSources",
+    "Shaft",
+    "gear_train_lines",
+    "kinematic_lines",
+]
 
 
 @dataclass(frozen=True)
@@ -233,3 +241,27 @@ def kinematic_lines(
                         add("cross", ((carrier.name, k), (modulation.name, sign * n)))
     lines.sort(key=lambda line: line.frequency_hz)
     return lines
+
+
+def gear_train_lines(
+    input_hz: float,
+    teeth: Sequence[tuple[int, int]],
+    f_max_hz: float,
+    harmonics: int = 6,
+    sidebands: int = 3,
+    shaft_orders: int = 30,
+) -> list[KinematicLine]:
+    """The lines a gear train's spectrum is labelled with, everywhere gearbody labels one
+    (``Result.spectrum``, the report): ``harmonics`` mesh harmonics, ``shaft_orders`` shaft orders,
+    sidebands of a pinion's rotation out to half way to the next harmonic (z_pinion // 2 orders, at least
+    ``sidebands``) and of the other shafts ``sidebands`` orders (closely spaced: few, or they would
+    explain nearly any peak). ``input_hz``: the first pinion's rotation frequency; ``teeth``: (z_pinion,
+    z_wheel) of each stage in power-flow order."""
+    sources = KinematicSources.gear_train(input_hz, list(teeth))
+    counts = {shaft.name: sidebands for shaft in sources.shafts}
+    for (z_pinion, _), mesh in zip(teeth, sources.meshes, strict=True):
+        pinion = mesh.shafts[0]
+        counts[pinion] = max(counts[pinion], z_pinion // 2)
+    return kinematic_lines(
+        sources, f_max_hz, harmonics=harmonics, sidebands=counts, shaft_orders=shaft_orders
+    )

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gearbody.analysis import amplitude_spectrum, fold_over_mesh_period
+from gearbody.analysis import fold_over_mesh_period
 
 from ..signals import stage_file_tag
 
@@ -102,7 +102,7 @@ def _spectrum_plot(result: Result, out: Path, title: str) -> Path:
     f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
     name = result.vibration_signal_name
     t_win = result.time_s[win]
-    spec = amplitude_spectrum(result[name][win], result.sample_rate_hz)
+    spec = result.spectrum(name).spectrum  # Result.spectrum's: the one composition (labels in the report)
     z1, z2 = result.teeth(0)
     shafts = {"f_1": f_mesh / z1, "f_2": f_mesh / z2} if f_mesh > 0 else {}
     unit = "rad/s²" if name.endswith("rad_s2") else "m/s²"

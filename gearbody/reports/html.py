@@ -15,12 +15,9 @@ import numpy as np
 
 from gearbody.analysis import (
     KinematicLine,
-    KinematicSources,
-    amplitude_spectrum,
     condition_indicators_from_average,
     fold_over_mesh_period,
-    kinematic_lines,
-    label_peaks,
+    gear_train_lines,
     peaks_to_rows,
     synchronous_average,
 )
@@ -38,15 +35,9 @@ explain nearly any peak)."""
 
 
 def spectrum_lines(input_hz: float, teeth: list[tuple[int, int]], f_max_hz: float) -> list[KinematicLine]:
-    """The kinematic lines the report labels peaks with: 6 mesh harmonics, 30 shaft orders, and
-    sidebands of a pinion's rotation out to half way to the next harmonic (z_pinion // 2 orders), of
-    other shafts :data:`WHEEL_SIDEBANDS` orders."""
-    sources = KinematicSources.gear_train(input_hz, teeth)
-    sidebands = {shaft.name: WHEEL_SIDEBANDS for shaft in sources.shafts}
-    for (z_pinion, _), mesh in zip(teeth, sources.meshes, strict=True):
-        pinion = mesh.shafts[0]
-        sidebands[pinion] = max(sidebands[pinion], z_pinion // 2)
-    return kinematic_lines(sources, f_max_hz, harmonics=6, sidebands=sidebands, shaft_orders=30)
+    """The kinematic lines the report labels peaks with (those of ``Result.spectrum``):
+    :func:`gearbody.analysis.gear_train_lines` with its defaults."""
+    return gear_train_lines(input_hz, teeth, f_max_hz, sidebands=WHEEL_SIDEBANDS)
 
 
 PEAK_COLUMNS = {
@@ -94,28 +85,19 @@ def report_sections(result: Result) -> dict[str, Any]:
     name = result.vibration_signal_name
     signal = result[name]
     z1 = int(result.meta["pinion_teeth"])
-    stages = result.meta.get("stages") or [{"pinion_teeth": z1, "wheel_teeth": result.meta["wheel_teeth"]}]
-    teeth = [(int(s["pinion_teeth"]), int(s["wheel_teeth"])) for s in stages]
     f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
     out: dict[str, Any] = {"summary": summary, "signal": name, "figures": {}}
 
-    # labelled spectrum of the vibration signal over the final window
-    spec = amplitude_spectrum(signal[win], result.sample_rate_hz, window="hann")
+    # the labelled spectrum of the vibration signal over the final window: Result.spectrum's, the one
+    # composition of signal, window, lines and defaults
+    labelled = result.spectrum(name)
     unit = "rad/s^2" if name.endswith("rad_s2") else "m/s^2"
-    peaks = []
+    peaks = labelled.peaks
     if f_mesh > 0:
-        f_max = min(result.sample_rate_hz / 2, 6 * f_mesh)
-        lines = spectrum_lines(f_mesh / z1, teeth, f_max)
-        peaks = label_peaks(
-            spec,
-            lines,
-            tolerance_hz=1.5 * spec.resolution_hz,
-            min_prominence_db=12.0,
-            max_peaks=40,
-            f_max_hz=f_max,
-        )
         title = f"spectrum of {name} [{unit}], last {result.FINAL_FRACTION:.0%} of the run"
-        fig = labelled_spectrum_figure(spec, peaks, title=title, unit=unit, f_max_hz=f_max)
+        fig = labelled_spectrum_figure(
+            labelled.spectrum, peaks, title=title, unit=unit, f_max_hz=labelled.f_max_hz
+        )
         out["figures"]["spectrum"] = png_base64(fig)
     out["peaks"] = peaks_to_rows(peaks)
     out["unit"] = unit
