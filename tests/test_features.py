@@ -161,3 +161,38 @@ def test_features_of_a_simulated_run(steady_scenario):
     assert got["line_amplitude:signal=pinion_accel_rad_s2,mesh=1"] == pytest.approx(expected, rel=1e-12)
     assert got["kd_max"] == pytest.approx(float(np.max(res.kd[win])))
     assert got["separation_fraction"] == 0.0
+
+
+def test_a_feature_registered_from_outside_gearbody_is_parsed_and_evaluated_everywhere():
+    """A new analysis is one module: it registers its FeatureKind, and Result.features and the studies'
+    parsing know it; unknown options are refused as for gearbody's own."""
+    from gearbody import load_scenario, simulate
+    from gearbody.analysis.features import (
+        WINDOW_OPTIONS,
+        FeatureKind,
+        parse_feature,
+        register_feature,
+        unregister_feature,
+    )
+
+    def peak_to_peak(spec, record, names, mask):
+        x = record.signal(names[0])[mask]
+        return float(np.max(x) - np.min(x))
+
+    kind = FeatureKind(
+        ("signal", *WINDOW_OPTIONS), lambda spec, record: (str(spec.options["signal"]),), peak_to_peak
+    )
+    register_feature("test_peak_to_peak", kind)
+    try:
+        result = simulate(load_scenario("two-wheel", ["operation.t_end_s=0.05"]))
+        text = "test_peak_to_peak:signal=mesh_force_N,fraction=0.5"
+        value = result.features([text])[text]
+        mask = result.record().window({"fraction": 0.5})
+        assert 0 < np.count_nonzero(mask) < mask.size
+        assert value == np.ptp(result["mesh_force_N"][mask]) > 0
+        with pytest.raises(FeatureError, match="order"):
+            parse_feature("test_peak_to_peak:order=2")
+    finally:
+        unregister_feature("test_peak_to_peak")
+    with pytest.raises(FeatureError, match="no feature 'test_peak_to_peak'"):
+        parse_feature("test_peak_to_peak:signal=mesh_force_N")

@@ -38,8 +38,9 @@ refuses them.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -57,6 +58,8 @@ __all__ = [
     "FeatureError",
     "FeatureSpec",
     "Record",
+    "FEATURE_KINDS",
+    "FeatureKind",
     "evaluate_feature",
     "evaluate_features",
     "feature_signals",
@@ -66,7 +69,9 @@ __all__ = [
     "natural_frequency_hz",
     "operating_periods_s",
     "parse_feature",
+    "register_feature",
     "resonance_speed",
+    "unregister_feature",
 ]
 
 DEFAULT_FRACTION = 0.25
@@ -379,66 +384,111 @@ def _parallel_first_stage(spec: FeatureSpec, record: Record) -> tuple[int, int]:
     return int(record.pinion_teeth), int(record.wheel_teeth)
 
 
-def feature_signals(spec: FeatureSpec | str, record: Record) -> tuple[str, ...]:
-    """Names of the signals the feature reads from ``record`` (whether the record holds them or not);
-    FeatureError when the feature does not apply to the stage it names (a planet of a parallel stage, a
-    spectral line of a record without a parallel first stage)."""
-    spec = parse_feature(spec) if isinstance(spec, str) else spec
-    name, o = spec.name, spec.options
-    if name == "natural_frequency_hz":
-        return ()
-    if name.startswith("kd_"):
-        return _mesh_signals(spec, record, "kd")
-    if name == "separation_fraction":
-        return _mesh_signals(spec, record, "force_N")
-    if "signal" not in o:
-        raise FeatureError(f"feature {spec}: give the signal, e.g. {name}:signal=pinion_accel_rad_s2")
-    if name == "rms":
-        return (str(o["signal"]),)
+# -- the registry: every feature is a FeatureKind, looked up by name --------------------------------------
+@dataclass(frozen=True)
+class FeatureKind:
+    """What a feature is: the options it takes, the signals it reads from a record (``signals(spec,
+    record)``, FeatureError where it does not apply) and its value (``value(spec, record, names, mask)``
+    on those signals over the window ``mask``; ``windowed=False``: ``mask`` is None and no window
+    option applies)."""
+
+    options: tuple[str, ...]
+    signals: Callable[[FeatureSpec, Record], tuple[str, ...]]
+    value: Callable[[FeatureSpec, Record, tuple[str, ...], Any], float]
+    windowed: bool = True
+
+
+FEATURE_KINDS: dict[str, FeatureKind] = {}
+"""Every feature by name (:func:`register_feature`); ``FEATURES`` lists their options."""
+
+
+def register_feature(name: str, kind: FeatureKind) -> None:
+    """Make feature ``name`` known to every feature user (``Result.features``, the studies' --feature,
+    sensitivity and calibration targets): a new analysis is one module that registers its kind."""
+    if not name.isidentifier():
+        raise ValueError(f"a feature name is an identifier, got {name!r}")
+    FEATURE_KINDS[name] = kind
+    FEATURES[name] = kind.options
+
+
+def unregister_feature(name: str) -> None:
+    """Forget feature ``name`` (a test's or a plug-in's clean-up)."""
+    FEATURE_KINDS.pop(name, None)
+    FEATURES.pop(name, None)
+
+
+def _needs_signal(spec: FeatureSpec) -> str:
+    if "signal" not in spec.options:
+        raise FeatureError(f"feature {spec}: give the signal, e.g. {spec.name}:signal=pinion_accel_rad_s2")
+    return str(spec.options["signal"])
+
+
+def _kd_signals(spec: FeatureSpec, record: Record) -> tuple[str, ...]:
+    return _mesh_signals(spec, record, "kd")
+
+
+def _kd_value(spec: FeatureSpec, record: Record, names: tuple[str, ...], mask) -> float:
+    return kd_statistic(np.concatenate([record.signal(n)[mask] for n in names]), spec.name[3:])
+
+
+def _separation_signals(spec: FeatureSpec, record: Record) -> tuple[str, ...]:
+    return _mesh_signals(spec, record, "force_N")
+
+
+def _separation_value(spec: FeatureSpec, record: Record, names: tuple[str, ...], mask) -> float:
+    t = record.time_s[mask]
+    return float(max(separation_stats(record.signal(n)[mask], t).separated_fraction for n in names))
+
+
+def _rms_signals(spec: FeatureSpec, record: Record) -> tuple[str, ...]:
+    return (_needs_signal(spec),)
+
+
+def _rms_value(spec: FeatureSpec, record: Record, names: tuple[str, ...], mask) -> float:
+    return rms(record.signal(str(spec.options["signal"]))[mask])
+
+
+def _first_stage_signals(spec: FeatureSpec, record: Record) -> tuple[str, ...]:
+    """A spectral line or synchronous-average feature: its signal and the pinion angle (and the wheel's
+    angle, when recorded, for an indicator of the wheel)."""
+    signal = _needs_signal(spec)
     _parallel_first_stage(spec, record)
-    extra = ("wheel_angle_rad",) if name != "line_amplitude" and o.get("gear") == "wheel" else ()
-    return (str(o["signal"]), "pinion_angle_rad", *(e for e in extra if e in record.signals))
+    o = spec.options
+    extra = ("wheel_angle_rad",) if spec.name != "line_amplitude" and o.get("gear") == "wheel" else ()
+    return (signal, "pinion_angle_rad", *(e for e in extra if e in record.signals))
 
 
-def evaluate_feature(spec: FeatureSpec | str, record: Record) -> float:
-    """The value of one feature of ``record`` (see the module's table for names, options and units)."""
-    spec = parse_feature(spec) if isinstance(spec, str) else spec
-    name, o = spec.name, dict(spec.options)
-    if name == "natural_frequency_hz":
-        return natural_frequency_hz(record.natural_frequencies_hz, int(o.get("mode", 1)))
-    names = feature_signals(spec, record)
-    mask = record.window(o)
-    if name.startswith("kd_"):
-        return kd_statistic(np.concatenate([record.signal(n)[mask] for n in names]), name[3:])
-    if name == "separation_fraction":
-        t = record.time_s[mask]
-        return float(max(separation_stats(record.signal(n)[mask], t).separated_fraction for n in names))
+def _line_amplitude_value(spec: FeatureSpec, record: Record, names: tuple[str, ...], mask) -> float:
+    o = spec.options
     x = record.signal(str(o["signal"]))[mask]
-    if name == "rms":
-        return rms(x)
     z1, z2 = _parallel_first_stage(spec, record)
-    if name == "line_amplitude":
-        f = line_frequency_hz(
-            record.pinion_hz(mask),
-            z1,
-            z2,
-            int(o.get("mesh", 1)),
-            int(o.get("order", 0)),
-            str(o.get("shaft", "pinion")),
-        )
-        bins = float(o.get("tolerance_bins", 2.0))
-        if int(o.get("order", 0)) != 0:  # a sideband or shaft order: its neighbours lie f_shaft away
-            shaft = str(o.get("shaft", "pinion"))
-            f_shaft = abs(line_frequency_hz(record.pinion_hz(mask), z1, z2, 0, 1, shaft))
-            tolerance_hz = bins * record.sample_rate_hz / np.count_nonzero(mask)
-            if tolerance_hz >= f_shaft / 2:
-                duration = record.time_s[mask][-1] - record.time_s[mask][0]
-                raise FeatureError(
-                    f"feature {spec}: a {duration:.3g} s window resolves lines to {tolerance_hz:.3g} Hz, not "
-                    f"the {f_shaft:.3g} Hz between this line and the next ({shaft} orders): use a window "
-                    f"longer than {2 * bins / f_shaft:.3g} s or fewer tolerance_bins"
-                )
-        return line_amplitude(x, record.sample_rate_hz, f, bins)
+    f = line_frequency_hz(
+        record.pinion_hz(mask),
+        z1,
+        z2,
+        int(o.get("mesh", 1)),
+        int(o.get("order", 0)),
+        str(o.get("shaft", "pinion")),
+    )
+    bins = float(o.get("tolerance_bins", 2.0))
+    if int(o.get("order", 0)) != 0:  # a sideband or shaft order: its neighbours lie f_shaft away
+        shaft = str(o.get("shaft", "pinion"))
+        f_shaft = abs(line_frequency_hz(record.pinion_hz(mask), z1, z2, 0, 1, shaft))
+        tolerance_hz = bins * record.sample_rate_hz / np.count_nonzero(mask)
+        if tolerance_hz >= f_shaft / 2:
+            duration = record.time_s[mask][-1] - record.time_s[mask][0]
+            raise FeatureError(
+                f"feature {spec}: a {duration:.3g} s window resolves lines to {tolerance_hz:.3g} Hz, not "
+                f"the {f_shaft:.3g} Hz between this line and the next ({shaft} orders): use a window "
+                f"longer than {2 * bins / f_shaft:.3g} s or fewer tolerance_bins"
+            )
+    return line_amplitude(x, record.sample_rate_hz, f, bins)
+
+
+def _indicator_value(spec: FeatureSpec, record: Record, names: tuple[str, ...], mask) -> float:
+    o = spec.options
+    x = record.signal(str(o["signal"]))[mask]
+    z1, z2 = _parallel_first_stage(spec, record)
     gear = str(o.get("gear", "pinion"))
     if gear not in ("pinion", "wheel"):
         raise FeatureError(f"feature {spec}: gear = {gear!r}; valid are 'pinion', 'wheel'")
@@ -452,7 +502,52 @@ def evaluate_feature(spec: FeatureSpec | str, record: Record) -> float:
     if abs(angle[-1] - angle[0]) < 4 * math.pi:
         raise FeatureError(f"feature {spec}: the window holds less than 2 revolutions of the {gear}")
     average = synchronous_average(x, angle, teeth=teeth)
-    return float(condition_indicators_from_average(average).as_dict()[INDICATORS[name]])
+    return float(condition_indicators_from_average(average).as_dict()[INDICATORS[spec.name]])
+
+
+def _no_signals(spec: FeatureSpec, record: Record) -> tuple[str, ...]:
+    return ()
+
+
+def _natural_frequency_value(spec: FeatureSpec, record: Record, names: tuple[str, ...], mask) -> float:
+    return natural_frequency_hz(record.natural_frequencies_hz, int(spec.options.get("mode", 1)))
+
+
+for _name, _options in list(FEATURES.items()):  # gearbody's own features, in FEATURES' order
+    if _name.startswith("kd_"):
+        register_feature(_name, FeatureKind(_options, _kd_signals, _kd_value))
+    elif _name == "separation_fraction":
+        register_feature(_name, FeatureKind(_options, _separation_signals, _separation_value))
+    elif _name == "rms":
+        register_feature(_name, FeatureKind(_options, _rms_signals, _rms_value))
+    elif _name == "line_amplitude":
+        register_feature(_name, FeatureKind(_options, _first_stage_signals, _line_amplitude_value))
+    elif _name in INDICATORS:
+        register_feature(_name, FeatureKind(_options, _first_stage_signals, _indicator_value))
+    elif _name == "natural_frequency_hz":
+        register_feature(
+            _name, FeatureKind(_options, lambda spec, record: (), _natural_frequency_value, False)
+        )
+del _name, _options
+
+
+def feature_signals(spec: FeatureSpec | str, record: Record) -> tuple[str, ...]:
+    """Names of the signals the feature reads from ``record`` (whether the record holds them or not);
+    FeatureError when the feature does not apply to the stage it names (a planet of a parallel stage, a
+    spectral line of a record without a parallel first stage)."""
+    spec = parse_feature(spec) if isinstance(spec, str) else spec
+    return FEATURE_KINDS[spec.name].signals(spec, record)
+
+
+def evaluate_feature(spec: FeatureSpec | str, record: Record) -> float:
+    """The value of one feature of ``record`` (see the module's table for names, options and units)."""
+    spec = parse_feature(spec) if isinstance(spec, str) else spec
+    kind = FEATURE_KINDS[spec.name]
+    if not kind.windowed:
+        return kind.value(spec, record, (), None)
+    names = kind.signals(spec, record)
+    mask = record.window(dict(spec.options))
+    return kind.value(spec, record, names, mask)
 
 
 def evaluate_features(specs: Sequence[FeatureSpec | str], record: Record) -> dict[str, float]:
