@@ -93,15 +93,8 @@ MESH_OPTIONS = ("stage", "planet", "mesh")
 """Which mesh a K_d feature reads: the stage (1-based) and, on a planetary stage, the planet (1..N) and
 the mesh (``sun`` or ``ring``); without them every planet mesh of the stage."""
 PLANET_MESHES = ("sun", "ring")
-FEATURES: dict[str, tuple[str, ...]] = {
-    **{f"kd_{s}": (*MESH_OPTIONS, *WINDOW_OPTIONS) for s in KD_STATISTICS},
-    "separation_fraction": (*MESH_OPTIONS, *WINDOW_OPTIONS),
-    "rms": ("signal", *WINDOW_OPTIONS),
-    "line_amplitude": ("signal", "mesh", "order", "shaft", "tolerance_bins", *WINDOW_OPTIONS),
-    **{name: ("signal", "gear", *WINDOW_OPTIONS) for name in INDICATORS},
-    "natural_frequency_hz": ("mode",),
-}
-"""Every feature name and the options it takes."""
+FEATURES: dict[str, tuple[str, ...]] = {}
+"""Every feature name and the options it takes (filled by :func:`register_feature`, below)."""
 
 
 class FeatureError(InputError):
@@ -513,22 +506,28 @@ def _natural_frequency_value(spec: FeatureSpec, record: Record, names: tuple[str
     return natural_frequency_hz(record.natural_frequencies_hz, int(spec.options.get("mode", 1)))
 
 
-for _name, _options in list(FEATURES.items()):  # gearbody's own features, in FEATURES' order
-    if _name.startswith("kd_"):
-        register_feature(_name, FeatureKind(_options, _kd_signals, _kd_value))
-    elif _name == "separation_fraction":
-        register_feature(_name, FeatureKind(_options, _separation_signals, _separation_value))
-    elif _name == "rms":
-        register_feature(_name, FeatureKind(_options, _rms_signals, _rms_value))
-    elif _name == "line_amplitude":
-        register_feature(_name, FeatureKind(_options, _first_stage_signals, _line_amplitude_value))
-    elif _name in INDICATORS:
-        register_feature(_name, FeatureKind(_options, _first_stage_signals, _indicator_value))
-    elif _name == "natural_frequency_hz":
-        register_feature(
-            _name, FeatureKind(_options, lambda spec, record: (), _natural_frequency_value, False)
-        )
-del _name, _options
+# gearbody's own features, in the order messages list them
+_KD_OPTIONS = (*MESH_OPTIONS, *WINDOW_OPTIONS)
+for _statistic in KD_STATISTICS:
+    register_feature(f"kd_{_statistic}", FeatureKind(_KD_OPTIONS, _kd_signals, _kd_value))
+register_feature("separation_fraction", FeatureKind(_KD_OPTIONS, _separation_signals, _separation_value))
+register_feature("rms", FeatureKind(("signal", *WINDOW_OPTIONS), _rms_signals, _rms_value))
+register_feature(
+    "line_amplitude",
+    FeatureKind(
+        ("signal", "mesh", "order", "shaft", "tolerance_bins", *WINDOW_OPTIONS),
+        _first_stage_signals,
+        _line_amplitude_value,
+    ),
+)
+for _indicator in INDICATORS:
+    register_feature(
+        _indicator, FeatureKind(("signal", "gear", *WINDOW_OPTIONS), _first_stage_signals, _indicator_value)
+    )
+register_feature(
+    "natural_frequency_hz", FeatureKind(("mode",), _no_signals, _natural_frequency_value, windowed=False)
+)
+del _statistic, _indicator
 
 
 def feature_signals(spec: FeatureSpec | str, record: Record) -> tuple[str, ...]:
