@@ -367,3 +367,19 @@ class Outcome:
 GOOD = {"ok", "usage", "refused", "numerical failure", "failed"}
 """The outcome kinds a command line may end in (exit 0, 2 with argparse's usage or one line, 3 with one
 line, 1 where documented); anything else is a finding."""
+
+
+def runner_fixture(name: str, report: Report):
+    """A module-scoped ``runner`` fixture: a :class:`CommandRunner` in a fresh folder ``name``, stopped
+    at the module's end, when ``report``'s counts are written and printed."""
+    import pytest
+
+    @pytest.fixture(scope="module")
+    def runner(tmp_path_factory, request):
+        r = CommandRunner(tmp_path_factory.mktemp(name))
+        yield r
+        r.stop()
+        report.write()
+        print_line(request, "\n" + report.line())
+
+    return runner

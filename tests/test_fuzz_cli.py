@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from fuzzing import GOOD, SCALE, CommandRunner, Report, fuzz_settings, leaves, print_line
+from fuzzing import GOOD, SCALE, CommandRunner, Report, fuzz_settings, leaves, runner_fixture
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -467,13 +467,7 @@ def materialise(tokens: list, folder: Path, scene: str) -> tuple[list[str], str]
 # -- the tests ---------------------------------------------------------------------------------------
 
 
-@pytest.fixture(scope="module")
-def runner(tmp_path_factory, request):
-    r = CommandRunner(tmp_path_factory.mktemp("fuzz-cli"))
-    yield r
-    r.stop()
-    REPORT.write()
-    print_line(request, "\n" + REPORT.line())
+runner = runner_fixture("fuzz-cli", REPORT)
 
 
 def check(runner: CommandRunner, tokens: list, kind: str, expected: set[str] = GOOD) -> None:

@@ -13,7 +13,7 @@ import os
 import shutil
 
 import pytest
-from fuzzing import CommandRunner, Report, fuzz_settings, print_line, reproduce
+from fuzzing import Report, fuzz_settings, reproduce, runner_fixture
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -40,13 +40,7 @@ SCENES = ("two-wheel", "one-stage", "lateral-8dof", "planetary")
 REPORT = Report("full disk")
 
 
-@pytest.fixture(scope="module")
-def runner(tmp_path_factory, request):
-    r = CommandRunner(tmp_path_factory.mktemp("fuzz-disk"))
-    yield r
-    r.stop()
-    REPORT.write()
-    print_line(request, "\n" + REPORT.line())
+runner = runner_fixture("fuzz-disk", REPORT)
 
 
 def _temporary(folder) -> list:
