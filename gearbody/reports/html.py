@@ -29,15 +29,12 @@ from gearbody.result import Result
 __all__ = ["PEAK_COLUMNS", "report_sections", "spectrum_lines", "write_report"]
 
 MIN_TSA_REVOLUTIONS = 2
-WHEEL_SIDEBANDS = 3
-"""Sideband orders catalogued for a shaft that carries no pinion (closely spaced: few, or they would
-explain nearly any peak)."""
 
 
 def spectrum_lines(input_hz: float, teeth: list[tuple[int, int]], f_max_hz: float) -> list[KinematicLine]:
     """The kinematic lines the report labels peaks with (those of ``Result.spectrum``):
     :func:`gearbody.analysis.gear_train_lines` with its defaults."""
-    return gear_train_lines(input_hz, teeth, f_max_hz, sidebands=WHEEL_SIDEBANDS)
+    return gear_train_lines(input_hz, teeth, f_max_hz)
 
 
 PEAK_COLUMNS = {
