@@ -79,14 +79,16 @@ def _job(kind: str, scene: str, t_end: float, extra: list[str], arg: float | Non
         import exudyn as exu
         import exudyn.solver
 
-        from gearbody.assembly import static_lateral_displacements_m, torsional_layout
-        from gearbody.engine.build import build_torsional
-        from gearbody.engine.simulate import SOLVER_TYPES, initial_state, solver_settings
+        from gearbody.assembly import initial_state, static_lateral_displacements_m, torsional_layout
+        from gearbody.assembly.topology import torsional_coordinates, torsional_system
+        from gearbody.engine.build import build
+        from gearbody.engine.simulate import SOLVER_TYPES, solver_settings
 
         q0, v0 = initial_state(sc)
-        layout = torsional_layout(sc)
-        built = build_torsional(layout, q0, v0, modal_mesh_stiffness_N_per_m=[1.25e9] * len(layout.meshes),
-                                lateral_u0=static_lateral_displacements_m(sc), sensors=True)
+        layout, u0 = torsional_layout(sc), static_lateral_displacements_m(sc)
+        k_mesh = [1.25e9] * len(layout.meshes)
+        system = torsional_system(layout, lateral_u0=u0, modal_mesh_stiffness_N_per_m=k_mesh)
+        built = build(system, *torsional_coordinates(layout, q0, v0, u0))
         if kind == "python-floor":
             from exudyn.itemInterface import ObjectGenericODE2
 

@@ -12,9 +12,24 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model import Scenario
-from ..physics.lateral import mesh_directions
+from ..physics.bearings import LinearBearing
+from ..physics.lateral import mesh_directions, tangent_stiffness_N_per_m
+from ..physics.mesh import mean_stiffness_N_per_m
 from ..signals import gear_names
 from .parameters import mesh_parameters_from_scenario, pack_drive_parameters
+from .system import (
+    BearingItem,
+    Body,
+    Constraint,
+    DriveItem,
+    MatrixItem,
+    MeshItem,
+    MullerItem,
+    PairMesh,
+    Spring,
+    SystemLayout,
+    TorqueItem,
+)
 
 
 @dataclass(frozen=True)
@@ -142,3 +157,138 @@ def reduced_mass_kg(scenario: Scenario) -> float:
         st.pinion.base_radius_m**2 / st.pinion.inertia_kg_m2
         + st.wheel.base_radius_m**2 / st.wheel.inertia_kg_m2
     )
+
+
+def coordinate_names(b: Inertia) -> list[str]:
+    """The coordinates of an inertia: its rotation, or x, y and rotation on lateral bearings."""
+    return [f"{b.name}_x", f"{b.name}_y", b.name] if b.lateral is not None else [b.name]
+
+
+def torsional_coordinates(
+    layout: TorsionalLayout, q0, v0, lateral_u0: dict[str, np.ndarray] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per-coordinate initial state from rotations and speeds per inertia (``q0``, ``v0``) and the centre
+    displacements of lateral gears (``lateral_u0`` by name; lateral velocities start at 0)."""
+    n = len(layout.inertias)
+    q0 = np.zeros(n) if q0 is None else q0
+    v0 = np.zeros(n) if v0 is None else v0
+    lateral_u0 = lateral_u0 or {}
+    q, v = [], []
+    for k, b in enumerate(layout.inertias):
+        if b.lateral is None:
+            q.append(float(q0[k]))
+            v.append(float(v0[k]))
+        else:
+            u0 = lateral_u0.get(b.name, np.zeros(2))
+            q += [float(u0[0]), float(u0[1]), float(q0[k])]
+            v += [0.0, 0.0, float(v0[k])]
+    return np.array(q), np.array(v)
+
+
+def torsional_system(
+    layout: TorsionalLayout,
+    *,
+    lateral_u0: dict[str, np.ndarray] | None = None,
+    modal_mesh_stiffness_N_per_m=None,
+) -> SystemLayout:
+    """The system of a torsional layout (gears optionally on lateral bearings): inertias as rotation or
+    planar bodies, shafts as springs, bearings (linear: springs per free direction; a law: its own item),
+    directions held fixed as constraints, then the drive. Without lateral gears the motor, load and meshes
+    are one drive item; with them each mesh, the motor and the load are items of their own.
+
+    With ``modal_mesh_stiffness_N_per_m`` (one value for all meshes, or one per mesh) the meshes are
+    constant line-of-action springs of that stiffness, nonlinear bearings their tangent stiffness at
+    ``lateral_u0``, and the motor and load are left out: the linearised system for natural frequencies.
+    """
+    lateral_u0 = lateral_u0 or {}
+    modal = modal_mesh_stiffness_N_per_m is not None
+    names: list[str] = []
+    bodies, rotation = [], []
+    for b in layout.inertias:
+        rotation.append(len(names) + (0 if b.lateral is None else 2))
+        names += coordinate_names(b)
+        if b.lateral is None:
+            bodies.append(Body("rotation", inertia_kg_m2=b.inertia_kg_m2))
+        else:
+            bodies.append(Body("planar", inertia_kg_m2=b.inertia_kg_m2, mass_kg=b.lateral.mass_kg))
+    items: list = [
+        Spring(rotation[sh.i], rotation[sh.j], sh.stiffness_Nm_per_rad, sh.damping_Nms_per_rad)
+        for sh in layout.shafts
+    ]
+    for k, b in enumerate(layout.inertias):
+        if b.lateral is not None:
+            items += _bearing_items(k, rotation[k] - 2, b, lateral_u0, modal)
+    if not modal and not layout.is_lateral and layout.motor_at is not None and layout.load_at is not None:
+        meshes = tuple(PairMesh(rotation[m.pinion], rotation[m.wheel], m.parameters) for m in layout.meshes)
+        items.append(DriveItem(rotation[layout.motor_at], rotation[layout.load_at], layout.drive, meshes))
+        return SystemLayout(tuple(names), tuple(bodies), tuple(items))
+    if modal:
+        k_modal = np.broadcast_to(np.asarray(modal_mesh_stiffness_N_per_m, float), (len(layout.meshes),))
+    for index, m in enumerate(layout.meshes):
+        bp, bw = layout.inertias[m.pinion], layout.inertias[m.wheel]
+        idx = _mesh_coordinate_index(bp, bw)
+        if modal:
+            g = np.zeros(len(coordinate_names(bp)) + len(coordinate_names(bw)))
+            g[idx[0]], g[idx[3]] = m.r_pinion_m, -m.r_wheel_m
+            if idx[1] >= 0:
+                g[idx[1]], g[idx[2]] = m.line_of_action
+            if idx[4] >= 0:
+                g[idx[4]], g[idx[5]] = -m.line_of_action[0], -m.line_of_action[1]
+            items.append(MatrixItem((m.pinion, m.wheel), k_modal[index] * np.outer(g, g)))
+        elif bp.lateral is None and bw.lateral is None:
+            items.append(MeshItem((m.pinion, m.wheel), m.parameters))
+        else:
+            free = [
+                float(d in b.lateral.free_directions) if b.lateral else 0.0 for b in (bp, bw) for d in (0, 1)
+            ]
+            geometry = np.array([*m.line_of_action, *m.friction_direction, *free])
+            items.append(MeshItem((m.pinion, m.wheel), m.parameters, geometry, idx))
+    if not modal:
+        if layout.motor_at is not None:
+            items.append(TorqueItem(layout.motor_at, "motor", layout.drive))
+        if layout.load_at is not None:
+            items.append(TorqueItem(layout.load_at, "load", layout.drive))
+    return SystemLayout(tuple(names), tuple(bodies), tuple(items), modal)
+
+
+def _bearing_items(body: int, first: int, b: Inertia, lateral_u0, modal: bool) -> list:
+    """A lateral gear's bearing: directions held fixed, then the law (springs when linear)."""
+    sup, law = b.lateral, b.lateral.bearing
+    items: list = [Constraint(first + d) for d in (0, 1) if d not in sup.free_directions]
+    if isinstance(law, LinearBearing):
+        k = (law.stiffness_x_N_per_m, law.stiffness_y_N_per_m)
+        c = (law.damping_x_Ns_per_m, law.damping_y_Ns_per_m)
+        items += [Spring(None, first + d, k[d], c[d]) for d in sup.free_directions]
+    elif modal:
+        K = np.zeros((3, 3))
+        K[:2, :2] = tangent_stiffness_N_per_m(law, lateral_u0.get(b.name, np.zeros(2)))
+        items.append(MatrixItem((body,), K))
+    else:
+        items.append(BearingItem(body, law, sup.free_directions))
+    return items
+
+
+def _mesh_coordinate_index(bp: Inertia, bw: Inertia) -> np.ndarray:
+    """Positions in the mesh item's coordinates of [pinion rot, x, y, wheel rot, x, y] (-1: none)."""
+    idx = []
+    offset = 0
+    for b in (bp, bw):
+        if b.lateral is None:
+            idx += [offset, -1, -1]
+            offset += 1
+        else:
+            idx += [offset + 2, offset, offset + 1]
+            offset += 3
+    return np.array(idx, dtype=np.int64)
+
+
+def muller_system(scenario: Scenario, *, modal: bool = False) -> SystemLayout:
+    """Muller's one-mass model (Fig. 1): the reduced mass on the line of action; ``modal``: the mesh as a
+    spring at its mean stiffness."""
+    body = (Body("translation", mass_kg=reduced_mass_kg(scenario)),)
+    P = mesh_parameters_from_scenario(scenario, friction=False)
+    if modal:
+        item = MatrixItem((0,), np.array([[mean_stiffness_N_per_m(P)]]))
+    else:
+        item = MullerItem(0, P, pack_drive_parameters(scenario), scenario.rated_mesh_force_N)
+    return SystemLayout(("deflection",), body, (item,), modal)

@@ -15,21 +15,15 @@ import math
 
 import exudyn as exu
 import numpy as np
-from exudyn.itemInterface import Node1D, ObjectGenericODE2, ObjectMass1D
 
 from ..analysis.modal import ModeSet
-from ..assembly import (
-    TorsionalLayout,
-    mesh_parameters_from_scenario,
-    reduced_mass_kg,
-    static_lateral_displacements_m,
-    torsional_layout,
-)
+from ..assembly import TorsionalLayout, static_lateral_displacements_m, torsional_layout
 from ..assembly.compound import compound_layout, has_bearing_laws, stage_static_displacements
+from ..assembly.compound_system import compound_system
+from ..assembly.topology import muller_system, torsional_coordinates, torsional_system
 from ..model import Scenario
 from ..physics import mean_stiffness_N_per_m
-from .build import build_torsional
-from .compound import build_compound
+from .build import build
 
 __all__ = ["ModeSet", "natural_frequencies", "scene_modes"]
 
@@ -68,37 +62,26 @@ def natural_frequencies(
     if mesh_stiffness_N_per_m is None:
         mesh_stiffness_N_per_m = [mean_stiffness_N_per_m(m.parameters) for m in layout.meshes]
     k = tuple(np.broadcast_to(np.asarray(mesh_stiffness_N_per_m, float), (len(layout.meshes),)))
-    built = build_torsional(layout, modal_mesh_stiffness_N_per_m=k, lateral_u0=lateral_u0, sensors=False)
+    system = torsional_system(layout, lateral_u0=lateral_u0, modal_mesh_stiffness_N_per_m=k)
+    built = build(system, *torsional_coordinates(layout, None, None, lateral_u0), sensors=False)
     freqs, shapes = _eigen(built.mbs, built.fixed_coordinates)
     keep = [i for i in range(len(built.dof_names)) if i not in built.fixed_coordinates]
-    masses = []
-    for b in layout.inertias:
-        masses += [b.inertia_kg_m2] if b.lateral is None else [b.lateral.mass_kg] * 2 + [b.inertia_kg_m2]
+    masses = system.masses
     return ModeSet(
         freqs[: len(keep)],
         shapes[keep][:, : len(keep)],
         [built.dof_names[i] for i in keep],
         k,
-        np.array(masses)[keep],
+        masses[keep],
     )
 
 
 def scene_modes(scenario: Scenario) -> ModeSet:
     """Modes of a scene at its mean mesh stiffness (healthy teeth)."""
     if scenario.meta.topology == "muller":
-        k_mean = mean_stiffness_N_per_m(mesh_parameters_from_scenario(scenario))
-        SC = exu.SystemContainer()
-        mbs = SC.AddSystem()
-        n = mbs.AddNode(Node1D(referenceCoordinates=[0.0]))
-        mbs.AddObject(ObjectMass1D(nodeNumber=n, mass=reduced_mass_kg(scenario)))
-        mbs.AddObject(
-            ObjectGenericODE2(
-                nodeNumbers=[n], massMatrix=np.zeros((1, 1)), stiffnessMatrix=np.array([[k_mean]])
-            )
-        )
-        mbs.Assemble()
-        freqs, shapes = _eigen(mbs)
-        return ModeSet(freqs, shapes, ["deflection"], (k_mean,))
+        system = muller_system(scenario, modal=True)
+        freqs, shapes = _eigen(build(system, sensors=False).mbs)
+        return ModeSet(freqs, shapes, ["deflection"], (float(system.items[0].stiffness[0, 0]),))
     if scenario.has_planetary:
         return compound_modes(scenario)
     return natural_frequencies(
@@ -119,16 +102,12 @@ def compound_modes(scenario: Scenario) -> ModeSet:
             states[link.stage] = stage_static_displacements(
                 link, link.input_sense * F * st.input_arm_m, -link.output_sense * F * st.output_arm_m
             )
-    built = build_compound(layout, np.zeros(n), np.zeros(n), sensors=False, modal=True, bearing_states=states)
+    system = compound_system(layout, modal=True, bearing_states=states)
+    built = build(system, np.zeros(n), np.zeros(n), sensors=False)
     freqs, shapes = _eigen(built.mbs)
-    masses = np.zeros(n)
-    masses[list(layout.rotation_bodies)] = layout.inertias
+    masses = system.masses
     k_mesh = [mean_stiffness_N_per_m(m.parameters) for m in layout.meshes]
     for link in layout.planetary:
-        members = (*link.layout.members, *([link.layout.planet] * (len(link.names) - 3)))
-        for m, member in enumerate(members):
-            o = link.first + 3 * m
-            masses[o : o + 3] = (member.mass_kg, member.mass_kg, member.inertia_kg_m2)
         k_mesh += [
             mean_stiffness_N_per_m(link.layout.sun_mesh),
             mean_stiffness_N_per_m(link.layout.ring_mesh),

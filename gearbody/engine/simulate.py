@@ -15,23 +15,16 @@ import exudyn as exu
 import exudyn.solver
 import numpy as np
 
-from ..assembly import (
-    check_resolved_modes,
-    initial_state,
-    mesh_frequency_hz,
-    static_lateral_displacements_m,
-    torsional_layout,
-)
-from ..assembly.compound import compound_initial_state, compound_layout
+from ..assembly import check_resolved_modes, mesh_frequency_hz
+from ..assembly.layouts import drive_system
 from ..errors import GearbodyError, SimulationError
 from ..model import Scenario
 from ..model.budget import memory_limit_bytes
 from ..model.scenario import SOLVER_METHODS
 from ..result import Result
 from ..signals import stage_prefix
-from .build import BuiltSystem, build_muller, build_torsional
+from .build import BuiltSystem, build
 from .collect import collect
-from .compound import build_compound
 from .hints import divergence_hint, mesh_range_hint, stall_hint
 
 SOLVER_TYPES = {name: getattr(exu.DynamicSolverType, name) for name in SOLVER_METHODS}
@@ -66,24 +59,17 @@ def solver_settings(scenario: Scenario) -> exu.SimulationSettings:
     return s
 
 
-def build(scenario: Scenario) -> tuple[BuiltSystem, np.ndarray, np.ndarray]:
+def build_scenario(scenario: Scenario) -> tuple[BuiltSystem, np.ndarray, np.ndarray]:
     """Exudyn system of a scenario at its initial state (an infeasible start raises InputError)."""
-    if scenario.has_planetary:
-        layout = compound_layout(scenario)
-        q0, v0 = compound_initial_state(scenario, layout)
-        return build_compound(layout, q0, v0), q0, v0
-    q0, v0 = initial_state(scenario)
-    if scenario.meta.topology == "muller":
-        return build_muller(scenario, q0, v0), q0, v0
-    lateral_u0 = static_lateral_displacements_m(scenario)
-    return build_torsional(torsional_layout(scenario), q0, v0, lateral_u0=lateral_u0), q0, v0
+    layout, q0, v0 = drive_system(scenario)
+    return build(layout, q0, v0), q0, v0
 
 
 def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
     """Simulate a scenario; raise :class:`SimulationError` on numerical failure."""
     wall0 = time.perf_counter()
     check_resolved_modes(scenario)  # a mode far above what the run resolves: refused (exit 2)
-    built, _, _ = build(scenario)
+    built, _, _ = build_scenario(scenario)
     build_s = time.perf_counter() - wall0
     mbs = built.mbs
     if scenario.meta.topology == "muller":  # anything near 1e3 m/s of deflection rate is divergence

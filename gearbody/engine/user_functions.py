@@ -12,22 +12,13 @@ import signal
 import threading
 import time
 
-import numba
 import numpy as np
 
-from ..assembly import Inertia
-from ..physics import load_torque_at, motor_torque_at
+from ..assembly.system import DriveItem, MullerItem
+from ..physics import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
+from ..physics.compiled import compiled
 from ..physics.lateral import lateral_mesh_forces
-from ..physics.mesh import torsional_mesh_forces
-
-
-def compiled(dispatcher, *example_args):
-    """The machine-code entry point of a numba function for the argument types of ``example_args``
-    (compiled, or loaded from numba's cache, on first use): calling it skips numba's per-call type
-    dispatch, ~0.15 of ~0.6 us per call of the drive's force law (benchmarks/RESULTS.md)."""
-    dispatcher(*example_args)
-    signature = tuple(numba.typeof(a) for a in example_args)
-    return dispatcher.overloads[signature].entry_point
+from ..physics.mesh import contact_force, single_mesh_drive_forces, torsional_mesh_forces
 
 
 def mesh_user_function(P: np.ndarray):
@@ -39,10 +30,8 @@ def mesh_user_function(P: np.ndarray):
     return mesh_force
 
 
-def lateral_mesh_user_function(m, bp: Inertia, bw: Inertia, idx: np.ndarray):
-    free = [float(d in b.lateral.free_directions) if b.lateral else 0.0 for b in (bp, bw) for d in (0, 1)]
-    geometry = np.array([*m.line_of_action, *m.friction_direction, *free])
-    P = m.parameters
+def lateral_mesh_user_function(P: np.ndarray, geometry: np.ndarray, idx: np.ndarray):
+    """A mesh where one or both gears translate: :func:`gearbody.physics.lateral.lateral_mesh_forces`."""
     zeros = np.zeros(int(idx.max()) + 1)
     forces = compiled(lateral_mesh_forces, zeros, zeros, idx, geometry, P)
 
@@ -306,3 +295,83 @@ def load_user_function(D: np.ndarray):
         return (-torque(t, D),)
 
     return load_torque
+
+
+def muller_user_function(item: MullerItem, watchdog: StallWatchdog):
+    """Muller's one-mass model (Fig. 1): the reduced mass driven by the rated force at the load fraction
+    against the contact force at the kinematic pinion angle (and the run's watchdog)."""
+    P, D, F_rated = item.parameters, item.drive, item.rated_force_N
+    contact = compiled(contact_force, 0.0, 0.0, 0.0, P)
+    angle = compiled(synchronous_angle_at, 0.0, D)
+    load = compiled(load_fraction_at, 0.0, D)
+
+    tick, check = watchdog.ticker()
+
+    def muller_force(mbs, t, itemNumber, q, q_t):
+        if tick():
+            check(t, q_t[0])
+        F = contact(angle(t, D), q[0], q_t[0], P)[0]
+        return [F_rated * load(t, D) - F]
+
+    return muller_force
+
+
+def drive_user_function(item: DriveItem, n: int, watchdog: StallWatchdog):
+    """The drive's one force function on all its ``n`` coordinates: motor torque (and the run's
+    watchdog), load torque, every torsional mesh and every slice term, one Python call per right-hand
+    side instead of one per item (Exudyn's per-call overhead dominates the cost). The one-stage drive
+    (motor, pinion, wheel, load) calls one fused compiled law; a drive without slice terms works on
+    Python lists, which is faster than numpy for a few coordinates."""
+    D, im, il = item.drive, item.motor_at, item.load_at
+    if not item.terms and len(item.meshes) == 1 and n == 4:
+        m = item.meshes[0]
+        if (im, m.pinion, m.wheel, il) == (0, 1, 2, 3):
+            P = m.parameters
+            forces = compiled(single_mesh_drive_forces, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, P, D)
+
+            tick, check = watchdog.ticker()
+
+            def drive_and_mesh(mbs, t, itemNumber, q, q_t):
+                if tick():
+                    check(t, q_t[0])
+                return forces(t, q_t[0], q[1], q[2], q_t[1], q_t[2], P, D)
+
+            return drive_and_mesh
+    motor = compiled(motor_torque_at, 0.0, 0.0, D)
+    load = compiled(load_torque_at, 0.0, D)
+    meshes = [(m.pinion, m.wheel, m.parameters) for m in item.meshes]
+    mesh_forces = compiled(torsional_mesh_forces, 0.0, 0.0, 0.0, 0.0, meshes[0][2]) if meshes else None
+    tick, check = watchdog.ticker()
+    if not item.terms:
+
+        def drive_and_meshes(mbs, t, itemNumber, q, q_t):
+            if tick():
+                check(t, q_t[im])
+            f = [0.0] * n
+            f[im] = motor(t, q_t[im], D)
+            f[il] -= load(t, D)
+            for ip, iw, P in meshes:
+                a, b = mesh_forces(q[ip], q[iw], q_t[ip], q_t[iw], P)
+                f[ip] += a
+                f[iw] += b
+            return f
+
+        return drive_and_meshes
+    terms = [(term.first, term.first + term.size, term.factory()) for term in item.terms]
+
+    def drive_items(mbs, t, itemNumber, q, q_t):
+        if tick():
+            check(t, q_t[im])
+        q, q_t = np.asarray(q), np.asarray(q_t)
+        f = np.zeros(n)
+        f[im] = motor(t, q_t[im], D)
+        f[il] -= load(t, D)
+        for ip, iw, P in meshes:
+            a, b = mesh_forces(q[ip], q[iw], q_t[ip], q_t[iw], P)
+            f[ip] += a
+            f[iw] += b
+        for a, b, forces in terms:
+            f[a:b] += forces(q[a:b], q_t[a:b])
+        return f
+
+    return drive_items
