@@ -17,6 +17,7 @@ import typing
 from typing import Any, get_args, get_origin, get_type_hints
 
 from ..errors import ScenarioError
+from .kinds import stage_kinds
 
 
 def param(
@@ -246,6 +247,8 @@ def _convert_variant(value: Any, kinds: list[type], ctx: _Ctx) -> Any:
     if not isinstance(value, dict):
         ctx.fail(value, f"must be a table of {_type_name(kinds[0])} keys")
     by_kind = {getattr(k, "KIND", _type_name(k)): k for k in kinds}
+    if any(kind.model in kinds for kind in stage_kinds()):  # design.stages: every registered stage kind
+        by_kind.update({kind.name: kind.model for kind in stage_kinds()})
     kind = value.get("type", getattr(kinds[0], "KIND", None))
     if not isinstance(kind, str) or kind not in by_kind:  # (an array or a table is no kind: unhashable)
         meta = {"choices": tuple(by_kind)}

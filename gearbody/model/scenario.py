@@ -20,6 +20,7 @@ from typing import Any, ClassVar
 from .budget import check_resources
 from .components import Gear, Machine, Motor, Shaft
 from .faults import DamagedTooth, Eccentricity, ErrorMode, PittedTooth
+from .kinds import register_stage_kind, stage_kind
 from .mesh import Mesh
 from .operation import Operation
 from .params import Node, ScenarioError, param, stage_key
@@ -215,9 +216,7 @@ class Scenario(Node):
             fields = {**fields, "design": resolve_design(fields["design"])}
         solver = fields.get("solver", Solver())
         if solver.method is None or solver.absolute_tolerance is None:  # from the accuracy level
-            planetary = "design" in fields and any(
-                isinstance(st, PlanetaryStage) for st in fields["design"].stages
-            )
+            planetary = "design" in fields and any(stage_kind(st).compound for st in fields["design"].stages)
             method, atol = default_solver(solver.accuracy, fields["meta"].topology, planetary)
             solver = dataclasses.replace(
                 solver,
@@ -257,10 +256,7 @@ class Scenario(Node):
             )
         _check_topology(self.meta.topology, self.design)
         for k, stage in enumerate(self.stages):
-            if isinstance(stage, PlanetaryStage):
-                _check_planetary_in_drive(k, self)
-            else:
-                _check_stage(k, stage)
+            stage_kind(stage).check(k, self)
         if self.has_planetary:
             pass  # the turning sense of each member is the stage's own (docs/planetary.md)
         elif self.meta.topology == "train":
@@ -297,13 +293,13 @@ class Scenario(Node):
 
     @property
     def has_planetary(self) -> bool:
-        """True when any stage is planetary."""
-        return any(isinstance(st, PlanetaryStage) for st in self.stages)
+        """True when any stage is planetary (of a kind that needs the compound layout)."""
+        return any(stage_kind(st).compound for st in self.stages)
 
     @property
     def parallel_stages(self) -> tuple[Stage, ...]:
         """The parallel stages (every stage of a drive without planetary ones)."""
-        return tuple(st for st in self.stages if not isinstance(st, PlanetaryStage))
+        return tuple(st for st in self.stages if not stage_kind(st).compound)
 
     @property
     def gear_ratio(self) -> float:
@@ -416,3 +412,7 @@ def _check_turning_senses(stages: tuple[Stage, ...]) -> None:
                 f"angle), e.g. {st.mesh.centre_line_deg + sense * 90:g} for a pure normal"
             )
         sense = -sense
+
+
+register_stage_kind("parallel", Stage, check=lambda k, scenario: _check_stage(k, scenario.stages[k]))
+register_stage_kind("planetary", PlanetaryStage, compound=True, check=_check_planetary_in_drive)

@@ -1,0 +1,86 @@
+"""Stage kinds: what a kind of gear stage declares so that the rest of gearbody treats it without asking
+which kind it is. A kind is registered once under its ``type`` name (the ``type`` key of a
+``design.stages`` table) with its model dataclass; each layer adds the hooks it calls (the assembly its
+layout part, the engine its signals, ...), or a kind from outside gearbody registers them all at once.
+
+The registry is the one place that maps a stage to its kind: code elsewhere calls ``stage_kind(st).hook``
+instead of branching on the stage's class.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, fields, replace
+
+__all__ = ["StageKind", "register_stage_kind", "stage_kind", "stage_kinds", "unregister_stage_kind"]
+
+
+@dataclass(frozen=True)
+class StageKind:
+    """A kind of gear stage and its hooks (None: the kind does not provide it).
+
+    - ``model``: the stage's dataclass (a :class:`gearbody.model.params.Node` with a ``KIND`` class
+      variable equal to ``name``); it provides ``ratio``, ``input_arm_m``, ``output_arm_m``,
+      ``transition_width``, ``mesh_frequency_hz(input_speed_rad_s)`` and ``coordinate_count``.
+    - ``compound``: True when the stage needs the compound layout (its members are planar bodies in the
+      drive's coordinates, :mod:`gearbody.assembly.compound`); parallel stages are not.
+    - ``check(k, scenario)``: refuses what a drive with this stage at index k cannot have.
+    - ``layout_part(scenario, k, first, modal)``: the stage's part of the compound layout, starting at
+      coordinate ``first`` (an object with ``names``, ``ends``, ``bodies()``, ``supports()``,
+      ``modal_items(system, bearing_states)``, ``drive_meshes()`` and ``drive_terms()``).
+    - ``input_name(scenario, k)``: the coordinate name of the stage's input rotation.
+    - ``metadata(scenario, k)``: the stage's entry of ``Result.meta["stages"]``.
+    - ``jump_times(scenario, k, names, t, q, v, signals)``: the times at which the stage's mesh laws
+      jump on the recorded states (for the anti-aliasing of the output).
+    """
+
+    name: str
+    model: type
+    compound: bool = False
+    check: Callable | None = None
+    layout_part: Callable | None = None
+    input_name: Callable | None = None
+    metadata: Callable | None = None
+    jump_times: Callable | None = None
+
+
+_KINDS: dict[str, StageKind] = {}
+HOOKS = tuple(f.name for f in fields(StageKind) if f.name not in ("name", "model"))
+
+
+def register_stage_kind(name: str, model: type | None = None, **hooks) -> StageKind:
+    """Register a stage kind (with ``model``), or add hooks to a registered one; returns the kind."""
+    unknown = set(hooks) - set(HOOKS)
+    if unknown:
+        raise TypeError(f"unknown stage-kind hook(s) {sorted(unknown)}; hooks: {', '.join(HOOKS)}")
+    if name in _KINDS:
+        kind = _KINDS[name]
+        if model is not None and model is not kind.model:
+            raise ValueError(f"stage kind {name!r} is registered with model {kind.model.__name__}")
+        kind = replace(kind, **hooks)
+    else:
+        if model is None:
+            raise ValueError(f"stage kind {name!r}: the first registration names its model dataclass")
+        if getattr(model, "KIND", None) != name:
+            raise ValueError(f"stage kind {name!r}: {model.__name__}.KIND must be {name!r}")
+        kind = StageKind(name, model, **hooks)
+    _KINDS[name] = kind
+    return kind
+
+
+def unregister_stage_kind(name: str) -> None:
+    """Remove a registered stage kind (a test's own kind, say)."""
+    _KINDS.pop(name, None)
+
+
+def stage_kinds() -> tuple[StageKind, ...]:
+    """Every registered stage kind, in registration order."""
+    return tuple(_KINDS.values())
+
+
+def stage_kind(stage) -> StageKind:
+    """The kind of a stage (its model's ``KIND``)."""
+    name = getattr(type(stage), "KIND", None)
+    if name not in _KINDS:
+        raise KeyError(f"{type(stage).__name__} is no registered stage kind ({', '.join(_KINDS)})")
+    return _KINDS[name]
