@@ -78,6 +78,10 @@ class ParallelMesh:
     inertias_kg_m2: tuple[float, float] = (0.0, 0.0)
 
     @property
+    def first(self) -> int:
+        return self.pinion
+
+    @property
     def coordinate_names(self) -> list[str]:
         return list(self.names)
 
@@ -198,6 +202,12 @@ def compound_initial_state(scenario: Scenario, layout: CompoundLayout) -> tuple[
     n = len(layout.dof_names)
     if scenario.operation.initial_state == "rest":
         return np.zeros(n), np.zeros(n)
+    for k, st in enumerate(scenario.stages):
+        if not isinstance(layout.parts[k], (ParallelMesh, PlanetaryLink)):
+            raise InputError(
+                f"operation.initial_state = 'steady': stage {k + 1} (type {stage_kind(st).name!r}) has no "
+                "steady start; use operation.initial_state = 'rest'"
+            )
     first = scenario.stages[0]
     pitch_rad = (
         2 * math.pi / (first.pinion.teeth if not isinstance(first, PlanetaryStage) else _input_teeth(first))

@@ -223,6 +223,30 @@ def _law_key(where: str, name: str, own_law: bool, planet_law: bool) -> str:
     return " and ".join(where + law for law in laws)
 
 
+def _add_part_diagonal(part, K, C, mass, keys, step: float = 1e-7) -> None:
+    """K_ii and C_ii of a stage part's drive terms by central differences at rest, and its bodies'
+    masses (diagonal entries of the mass matrix)."""
+    where = stage_key(part.stage)
+    c = part.first
+    for body in part.bodies():
+        values = {"rotation": [body.inertia_kg_m2], "translation": [body.mass_kg]}.get(
+            body.kind, [body.mass_kg, body.mass_kg, body.inertia_kg_m2]
+        )
+        for value in values:
+            mass[c], keys[c] = value, where + "(its bodies)"
+            c += 1
+    for term in part.drive_terms():
+        forces = term.factory()
+        zero = np.zeros(term.size)
+        for j in range(term.size):
+            e = np.zeros(term.size)
+            e[j] = step
+            dk = -(forces(e, zero)[j] - forces(-e, zero)[j]) / (2 * step)
+            dc = -(forces(zero, e)[j] - forces(zero, -e)[j]) / (2 * step)
+            _add(K[term.first + j], where + "(its force terms)", dk)
+            _add(C[term.first + j], where + "(its force terms)", dc)
+
+
 def _compound_frequencies(scenario: Scenario) -> list[CoordinateFrequency]:
     """The coordinates of a drive with planetary stages: shafts and parallel meshes as for trains, a
     planetary stage's K_ii and C_ii from its force law at the nominal assembly (finite differences of
@@ -321,6 +345,10 @@ def _compound_frequencies(scenario: Scenario) -> list[CoordinateFrequency]:
                         where + f"{name}.torsion_damping_Nms_per_rad",
                         member.torsion_damping_Nms_per_rad,
                     )
+    known = {id(p) for p in (*layout.meshes, *layout.planetary)}
+    for part in layout.parts:
+        if id(part) not in known:  # a stage kind registered from outside: its bodies and force terms
+            _add_part_diagonal(part, K, C, mass, keys)
     out = []
     for i in range(n):
         k, c = sum(K[i].values()), sum(C[i].values())

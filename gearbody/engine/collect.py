@@ -15,8 +15,8 @@ from ..assembly import gear_names, mesh_parameters_from_scenario, pack_drive_par
 from ..assembly.operating_point import nominal_speeds_rad_s
 from ..errors import SimulationError
 from ..model import Scenario, budget, scenario_to_dict
+from ..model.kinds import register_stage_kind, stage_kind
 from ..model.params import stage_key
-from ..model.planetary import PlanetaryStage
 from ..physics import load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.bearings import LinearBearing
 from ..physics.lateral import mesh_directions
@@ -25,7 +25,7 @@ from ..result import Result
 from ..signals import stage_prefix
 from ..version import __version__
 from .build import BuiltSystem
-from .planetary_signals import planetary_jump_times, planetary_signals, stage_input_name
+from .planetary_signals import stage_input_name
 from .sampling import OVERSAMPLING, CubicHermite, is_band_limited, mesh_jump_times
 
 __all__ = ["collect"]
@@ -87,6 +87,7 @@ def collect(scenario: Scenario, built: BuiltSystem) -> Result:
         "min_step_s": float(steps[steps > 0].min()) if n_steps else 0.0,
         "max_step_s": float(steps.max()) if n_steps else 0.0,
     }
+    stages = [_stage_meta(scenario, k) for k in range(len(scenario.stages))]
     meta = {
         "scene": scenario.name,
         "topology": scenario.meta.topology,
@@ -98,8 +99,8 @@ def collect(scenario: Scenario, built: BuiltSystem) -> Result:
         "output_rate_hz": rate,
         "dof_names": built.dof_names,
         "rated_mesh_force_N": scenario.rated_mesh_force_N,
-        **_first_stage_teeth(scenario.stages[0]),
-        "stages": [_stage_meta(scenario, k) for k in range(len(scenario.stages))],
+        **_first_stage_teeth(stages[0]),
+        "stages": stages,
         "sources": list(scenario.meta.sources),
         "nominal_speeds_rad_s": nominal_speeds_rad_s(scenario),
         "solver_statistics": stats,
@@ -107,28 +108,21 @@ def collect(scenario: Scenario, built: BuiltSystem) -> Result:
     return Result(time_s=t, signals=signals, meta=meta)
 
 
-def _first_stage_teeth(st) -> dict[str, int]:
+def _first_stage_teeth(stage_meta: dict) -> dict[str, int]:
     """pinion_teeth / wheel_teeth of a parallel first stage (a planetary one has its own in 'stages')."""
-    if isinstance(st, PlanetaryStage):
-        return {}
-    return {"pinion_teeth": st.pinion.teeth, "wheel_teeth": st.wheel.teeth}
+    return {key: stage_meta[key] for key in ("pinion_teeth", "wheel_teeth") if key in stage_meta}
 
 
 def _stage_meta(scenario: Scenario, k: int) -> dict:
+    """Stage k's entry of meta["stages"]: its kind's metadata (at least its type and rated force)."""
+    kind = stage_kind(scenario.stages[k])
+    if kind.metadata is None:
+        return {"type": kind.name, "rated_mesh_force_N": scenario.stage_rated_force_N(k)}
+    return kind.metadata(scenario, k)
+
+
+def _parallel_meta(scenario: Scenario, k: int) -> dict:
     st = scenario.stages[k]
-    if isinstance(st, PlanetaryStage):
-        return {
-            "type": "planetary",
-            "sun_teeth": st.sun.teeth,
-            "planet_teeth": st.planet.teeth,
-            "ring_teeth": st.ring.teeth,
-            "planets": st.planets,
-            "planet_angles_deg": [math.degrees(a) for a in st.geometry.planet_angles_rad],
-            "input": st.input,
-            "output": st.output,
-            "fixed": st.fixed,
-            "rated_mesh_force_N": scenario.stage_rated_force_N(k),
-        }
     return {
         "pinion_teeth": st.pinion.teeth,
         "wheel_teeth": st.wheel.teeth,
@@ -136,12 +130,32 @@ def _stage_meta(scenario: Scenario, k: int) -> dict:
     }
 
 
+def _planetary_meta(scenario: Scenario, k: int) -> dict:
+    st = scenario.stages[k]
+    return {
+        "type": "planetary",
+        "sun_teeth": st.sun.teeth,
+        "planet_teeth": st.planet.teeth,
+        "ring_teeth": st.ring.teeth,
+        "planets": st.planets,
+        "planet_angles_deg": [math.degrees(a) for a in st.geometry.planet_angles_rad],
+        "input": st.input,
+        "output": st.output,
+        "fixed": st.fixed,
+        "rated_mesh_force_N": scenario.stage_rated_force_N(k),
+    }
+
+
 def _point_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> dict[str, np.ndarray]:
+    """Every coordinate's motion, then the signals of each stage kind (the parallel kinds' first, then
+    the drive torques and the lateral gears' signals, then the compound kinds')."""
     signals = _torsional_signals(scenario, names, t, q, v, a, drive_torques=drive_torques)
     if scenario.is_lateral:
         signals.update(_lateral_signals(scenario, names, q, v, a, signals))
-    if scenario.has_planetary:
-        signals.update(planetary_signals(scenario, names, q, v, a))
+    for k, st in enumerate(scenario.stages):
+        kind = stage_kind(st)
+        if kind.compound and kind.signals is not None:
+            signals.update(kind.signals(scenario, k, names, t, q, v, a))
     return signals
 
 
@@ -180,14 +194,9 @@ def _band_limited_signals(scenario, names, t_fine, q, v, a, M=OVERSAMPLING) -> d
     t = t_fine[::M]
     jumps = []
     for k, st in enumerate(scenario.stages):
-        prefix = stage_prefix(k)
-        if isinstance(st, PlanetaryStage):
-            jumps += planetary_jump_times(scenario, k, names, t_fine, q, v)
-            continue
-        angle = fine[f"{gear_names(k)[0]}_angle_rad"]
-        delta = fine[prefix + "mesh_deflection_m"]
-        jumps.append(mesh_jump_times(t_fine, angle, delta, mesh_parameters_from_scenario(scenario, k)))
-    jumps = np.concatenate(jumps)
+        hook = stage_kind(st).jump_times
+        jumps += hook(scenario, k, names, t_fine, q, v, fine) if hook is not None else []
+    jumps = np.concatenate(jumps) if jumps else np.zeros(0)
     out = {}
     for name, x in fine.items():
         if is_band_limited(name):
@@ -249,28 +258,40 @@ def _torsional_signals(scenario, names, t, q, v, a, *, drive_torques=True) -> di
     # Stage 1's mesh signals carry the plain names (mesh_force_N, kd, ...); later stages are prefixed
     # stage_2_, stage_3_, ... and their K_d is relative to their own rated force.
     for k, st in enumerate(scenario.stages):
-        if isinstance(st, PlanetaryStage):
-            continue  # planetary_signals
-        pname, wname = gear_names(k)
-        ip, iw = names.index(pname), names.index(wname)
-        r1, r2 = st.pinion.base_radius_m, st.wheel.base_radius_m
-        P = mesh_parameters_from_scenario(scenario, k)
-        delta, rate = r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw]
-        n, m, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
-        sliding = np.zeros(len(t))
-        for name, sign in ((pname, 1.0), (wname, -1.0)):
-            if f"{name}_x" in names:
-                ix, iy = names.index(f"{name}_x"), names.index(f"{name}_y")
-                delta = delta + sign * (q[ix] * n[0] + q[iy] * n[1])
-                rate = rate + sign * (v[ix] * n[0] + v[iy] * n[1])
-                sliding = sliding + sign * (v[ix] * m[0] + v[iy] * m[1])
-        sig = _mesh_signals(q[ip], delta, rate, scenario.stage_rated_force_N(k), P, (v[ip], v[iw]), sliding)
-        sig["mesh_frequency_hz"] = st.pinion.teeth * v[ip] / (2 * math.pi)
-        prefix = stage_prefix(k)
-        out.update({prefix + key: value for key, value in sig.items()})
+        kind = stage_kind(st)
+        if not kind.compound and kind.signals is not None:
+            out.update(kind.signals(scenario, k, names, t, q, v, a))
     if drive_torques:
         out.update(_drive_torques(scenario, t, v[0]))
     return out
+
+
+def _parallel_signals(scenario, k: int, names, t, q, v, a) -> dict[str, np.ndarray]:
+    """A parallel stage's mesh signals (prefixed by its stage prefix)."""
+    st = scenario.stages[k]
+    pname, wname = gear_names(k)
+    ip, iw = names.index(pname), names.index(wname)
+    r1, r2 = st.pinion.base_radius_m, st.wheel.base_radius_m
+    P = mesh_parameters_from_scenario(scenario, k)
+    delta, rate = r1 * q[ip] - r2 * q[iw], r1 * v[ip] - r2 * v[iw]
+    n, m, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
+    sliding = np.zeros(len(t))
+    for name, sign in ((pname, 1.0), (wname, -1.0)):
+        if f"{name}_x" in names:
+            ix, iy = names.index(f"{name}_x"), names.index(f"{name}_y")
+            delta = delta + sign * (q[ix] * n[0] + q[iy] * n[1])
+            rate = rate + sign * (v[ix] * n[0] + v[iy] * n[1])
+            sliding = sliding + sign * (v[ix] * m[0] + v[iy] * m[1])
+    sig = _mesh_signals(q[ip], delta, rate, scenario.stage_rated_force_N(k), P, (v[ip], v[iw]), sliding)
+    sig["mesh_frequency_hz"] = st.pinion.teeth * v[ip] / (2 * math.pi)
+    prefix = stage_prefix(k)
+    return {prefix + key: value for key, value in sig.items()}
+
+
+def _parallel_jump_times(scenario, k: int, names, t_fine, q, v, fine) -> list[np.ndarray]:
+    angle = fine[f"{gear_names(k)[0]}_angle_rad"]
+    delta = fine[stage_prefix(k) + "mesh_deflection_m"]
+    return [mesh_jump_times(t_fine, angle, delta, mesh_parameters_from_scenario(scenario, k))]
 
 
 def _lateral_signals(scenario, names, q, v, a, signals) -> dict[str, np.ndarray]:
@@ -318,3 +339,13 @@ def _muller_signals(scenario, t, x, xd, xdd) -> dict[str, np.ndarray]:
     out["load_torque_Nm"] = np.array([load_torque_at(tk, D) for tk in t])
     out["mesh_frequency_hz"] = np.gradient(theta, t) * scenario.stages[0].pinion.teeth / (2 * math.pi)
     return out
+
+
+register_stage_kind(
+    "parallel",
+    input_name=lambda scenario, k: gear_names(k)[0],
+    metadata=_parallel_meta,
+    signals=_parallel_signals,
+    jump_times=_parallel_jump_times,
+)
+register_stage_kind("planetary", metadata=_planetary_meta)

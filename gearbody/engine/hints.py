@@ -11,6 +11,7 @@ import math
 
 from ..assembly import mesh_parameters_from_scenario
 from ..model import Scenario
+from ..model.kinds import register_stage_kind, stage_kind
 from ..model.params import stage_key
 from ..physics import mean_stiffness_N_per_m
 
@@ -44,27 +45,36 @@ def _zero_factor_teeth(scenario: Scenario) -> list[str]:
     ]
 
 
+def _jumps(where: str, m) -> list[str]:
+    """A mesh whose stiffness jumps by more than STIFFNESS_JUMP_RATIO at a sharp tooth change."""
+    lo, hi = sorted((m.stiffness_single_N_per_m, m.stiffness_double_N_per_m))
+    if m.transition_width == 0 and hi > STIFFNESS_JUMP_RATIO * lo:
+        return [
+            f"{where}.stiffness_single_N_per_m / stiffness_double_N_per_m "
+            f"({m.stiffness_single_N_per_m:.3g} / {m.stiffness_double_N_per_m:.3g} N/m)"
+        ]
+    return []
+
+
+def _parallel_jumps(st, k: int) -> list[str]:
+    return _jumps(stage_key(k, "mesh"), st.mesh) if st.mesh.stiffness_profile == "contact-ratio" else []
+
+
+def _planetary_jumps(st, k: int) -> list[str]:
+    return [
+        line for name in ("sun_mesh", "ring_mesh") for line in _jumps(stage_key(k, name), getattr(st, name))
+    ]
+
+
+register_stage_kind("parallel", stiffness_jumps=_parallel_jumps)
+register_stage_kind("planetary", stiffness_jumps=_planetary_jumps)
+
+
 def _jumping_meshes(scenario: Scenario) -> list[str]:
     out = []
     for k, st in enumerate(scenario.stages):
-        if not hasattr(st, "pinion"):  # planetary: its sun and ring meshes
-            for name in ("sun_mesh", "ring_mesh"):
-                m = getattr(st, name)
-                lo, hi = sorted((m.stiffness_single_N_per_m, m.stiffness_double_N_per_m))
-                if m.transition_width == 0 and hi > STIFFNESS_JUMP_RATIO * lo:
-                    out.append(
-                        f"{stage_key(k, name)}.stiffness_single_N_per_m / stiffness_double_N_per_m "
-                        f"({m.stiffness_single_N_per_m:.3g} / {m.stiffness_double_N_per_m:.3g} N/m)"
-                    )
-            continue
-        m = st.mesh
-        if m.stiffness_profile == "contact-ratio" and m.transition_width == 0:
-            lo, hi = sorted((m.stiffness_single_N_per_m, m.stiffness_double_N_per_m))
-            if hi > STIFFNESS_JUMP_RATIO * lo:
-                out.append(
-                    f"{stage_key(k, 'mesh')}.stiffness_single_N_per_m / stiffness_double_N_per_m "
-                    f"({m.stiffness_single_N_per_m:.3g} / {m.stiffness_double_N_per_m:.3g} N/m)"
-                )
+        hook = stage_kind(st).stiffness_jumps
+        out += hook(st, k) if hook is not None else []
     return out
 
 

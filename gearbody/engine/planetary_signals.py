@@ -14,10 +14,11 @@ from ..analysis.planet_pass import HannPassWindow, ring_sensor_signal
 from ..assembly.compound import PlanetaryLink, compound_layout
 from ..assembly.planetary_layout import CENTRAL
 from ..model import Scenario
+from ..model.kinds import register_stage_kind, stage_kind
 from ..model.planetary import PlanetaryStage
 from ..physics.mesh import mesh_phase_series
 from ..physics.planetary_mesh import stage_contact_series, stage_mesh_series
-from ..signals import gear_names, stage_prefix
+from ..signals import stage_prefix
 from .sampling import mesh_jump_times
 
 __all__ = ["planetary_jump_times", "planetary_signals", "stage_input_name"]
@@ -25,11 +26,11 @@ __all__ = ["planetary_jump_times", "planetary_signals", "stage_input_name"]
 
 def stage_input_name(scenario: Scenario, k: int) -> str:
     """The coordinate name of stage k's input rotation (pinion, or the planetary input member)."""
-    st = scenario.stages[k]
-    prefix = stage_prefix(k)
-    if isinstance(st, PlanetaryStage):
-        return prefix + st.input
-    return gear_names(k)[0]
+    return stage_kind(scenario.stages[k]).input_name(scenario, k)
+
+
+def _planetary_input_name(scenario: Scenario, k: int) -> str:
+    return stage_prefix(k) + scenario.stages[k].input
 
 
 def _links(scenario: Scenario) -> tuple[PlanetaryLink, ...]:
@@ -49,50 +50,65 @@ def planetary_signals(scenario: Scenario, names: list[str], q, v, a) -> dict[str
     """Every planetary stage's signals on the samples of q, v, a (rows in the order of ``names``)."""
     out: dict[str, np.ndarray] = {}
     for link in _links(scenario):
-        k, st = link.stage, scenario.stages[link.stage]
-        prefix = stage_prefix(k)
-        absolute, rate, G = _stage_coordinates(link, names, q, v)
-        states = stage_mesh_series(absolute, rate, G)  # law angle, deflection, rate per mesh
-        contacts = stage_contact_series(absolute, rate, G, *link.layout.mesh_arrays())  # F, T, v_T
-        for n in range(st.planets):
-            planet = f"{prefix}planet_{n + 1}"
-            laws = (("sun", link.layout.sun_mesh_of(n), 0), ("ring", link.layout.ring_mesh_of(n), 3))
-            for mesh, P, col in laws:
-                angle = np.ascontiguousarray(states[:, n, col])
-                delta = np.ascontiguousarray(states[:, n, col + 1])
-                F, T, v_T = (contacts[:, n, col + c] for c in range(3))
-                p, i, j = mesh_phase_series(angle, P)
-                key = f"{planet}_{mesh}_mesh"
-                out[key + "_force_N"] = F
-                out[key + "_friction_force_N"] = T  # opposes v_T: docs/planetary.md "Friction"
-                out[key + "_sliding_velocity_m_s"] = v_T  # T v_T <= 0 is the friction power
-                out[key + "_kd"] = F / link.rated_force_N
-                out[key + "_deflection_m"] = delta
-                out[key + "_phase"] = p
-                out[f"{key}_{mesh}_tooth"] = i
-                out[f"{key}_planet_tooth"] = j
-            out.update(_planet_bearing(link, names, q, n, planet))
-        for m, member in enumerate(link.layout.members):
-            name = link.names[m]
-            ix = names.index(name + "_x")
-            law = member.bearing_law
-            if law is not None:
-                on_member = np.array(
-                    [law.force_N(q[ix : ix + 2, i], v[ix : ix + 2, i]) for i in range(q.shape[1])]
-                ).T
-            for d, axis in enumerate("xy"):
-                u, du = q[ix + d], v[ix + d]
-                out[f"{name}_{axis}_m"] = u
-                out[f"{name}_{axis}_velocity_m_s"] = du
-                out[f"{name}_{axis}_accel_m_s2"] = a[ix + d]
-                if law is None:
-                    force = member.bearing_stiffness_N_per_m * u + member.bearing_damping_Ns_per_m * du
-                else:
-                    force = -on_member[d]
-                out[f"{name}_bearing_force_{axis}_N"] = force  # on the housing
-        w = {c: v[names.index(link.names[m])] for m, c in enumerate(CENTRAL)}
-        out[prefix + "mesh_frequency_hz"] = st.sun.teeth * np.abs(w["sun"] - w["carrier"]) / (2 * math.pi)
-        out[prefix + "ring_sensor_N"] = _ring_sensor(link, st, names, q, out, prefix)
+        out.update(_stage_signals(scenario, link, names, q, v, a))
+    return out
+
+
+def planetary_stage_signals(
+    scenario: Scenario, k: int, names: list[str], t, q, v, a
+) -> dict[str, np.ndarray]:
+    """Planetary stage k's signals on the samples of q, v, a (the stage kind's ``signals``)."""
+    return _stage_signals(scenario, compound_layout(scenario).parts[k], names, q, v, a)
+
+
+def _stage_signals(
+    scenario: Scenario, link: PlanetaryLink, names: list[str], q, v, a
+) -> dict[str, np.ndarray]:
+    out: dict[str, np.ndarray] = {}
+    k, st = link.stage, scenario.stages[link.stage]
+    prefix = stage_prefix(k)
+    absolute, rate, G = _stage_coordinates(link, names, q, v)
+    states = stage_mesh_series(absolute, rate, G)  # law angle, deflection, rate per mesh
+    contacts = stage_contact_series(absolute, rate, G, *link.layout.mesh_arrays())  # F, T, v_T
+    for n in range(st.planets):
+        planet = f"{prefix}planet_{n + 1}"
+        laws = (("sun", link.layout.sun_mesh_of(n), 0), ("ring", link.layout.ring_mesh_of(n), 3))
+        for mesh, P, col in laws:
+            angle = np.ascontiguousarray(states[:, n, col])
+            delta = np.ascontiguousarray(states[:, n, col + 1])
+            F, T, v_T = (contacts[:, n, col + c] for c in range(3))
+            p, i, j = mesh_phase_series(angle, P)
+            key = f"{planet}_{mesh}_mesh"
+            out[key + "_force_N"] = F
+            out[key + "_friction_force_N"] = T  # opposes v_T: docs/planetary.md "Friction"
+            out[key + "_sliding_velocity_m_s"] = v_T  # T v_T <= 0 is the friction power
+            out[key + "_kd"] = F / link.rated_force_N
+            out[key + "_deflection_m"] = delta
+            out[key + "_phase"] = p
+            out[f"{key}_{mesh}_tooth"] = i
+            out[f"{key}_planet_tooth"] = j
+        out.update(_planet_bearing(link, names, q, n, planet))
+    for m, member in enumerate(link.layout.members):
+        name = link.names[m]
+        ix = names.index(name + "_x")
+        law = member.bearing_law
+        if law is not None:
+            on_member = np.array(
+                [law.force_N(q[ix : ix + 2, i], v[ix : ix + 2, i]) for i in range(q.shape[1])]
+            ).T
+        for d, axis in enumerate("xy"):
+            u, du = q[ix + d], v[ix + d]
+            out[f"{name}_{axis}_m"] = u
+            out[f"{name}_{axis}_velocity_m_s"] = du
+            out[f"{name}_{axis}_accel_m_s2"] = a[ix + d]
+            if law is None:
+                force = member.bearing_stiffness_N_per_m * u + member.bearing_damping_Ns_per_m * du
+            else:
+                force = -on_member[d]
+            out[f"{name}_bearing_force_{axis}_N"] = force  # on the housing
+    w = {c: v[names.index(link.names[m])] for m, c in enumerate(CENTRAL)}
+    out[prefix + "mesh_frequency_hz"] = st.sun.teeth * np.abs(w["sun"] - w["carrier"]) / (2 * math.pi)
+    out[prefix + "ring_sensor_N"] = _ring_sensor(link, st, names, q, out, prefix)
     return out
 
 
@@ -128,7 +144,9 @@ def _planet_bearing(link: PlanetaryLink, names, q, n: int, planet: str) -> dict[
     }
 
 
-def planetary_jump_times(scenario: Scenario, k: int, names, t_s: np.ndarray, q, v) -> list[np.ndarray]:
+def planetary_jump_times(
+    scenario: Scenario, k: int, names, t_s: np.ndarray, q, v, signals=None
+) -> list[np.ndarray]:
     """Times where stage k's mesh laws jump (every planet's two meshes), for band-limited sampling."""
     link = next(link for link in _links(scenario) if link.stage == k)
     states = stage_mesh_series(*_stage_coordinates(link, names, q, v))
@@ -137,3 +155,11 @@ def planetary_jump_times(scenario: Scenario, k: int, names, t_s: np.ndarray, q, 
         for P, col in ((link.layout.sun_mesh_of(n), 0), (link.layout.ring_mesh_of(n), 3)):
             out.append(mesh_jump_times(t_s, states[:, n, col], states[:, n, col + 1], P))
     return out
+
+
+register_stage_kind(
+    "planetary",
+    input_name=_planetary_input_name,
+    signals=planetary_stage_signals,
+    jump_times=planetary_jump_times,
+)

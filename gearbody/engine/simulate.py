@@ -20,6 +20,7 @@ from ..assembly.layouts import drive_system
 from ..errors import GearbodyError, SimulationError
 from ..model import Scenario
 from ..model.budget import memory_limit_bytes
+from ..model.kinds import register_stage_kind, stage_kind
 from ..model.scenario import SOLVER_METHODS
 from ..result import Result
 from ..signals import stage_prefix
@@ -148,26 +149,33 @@ teeth in mesh, phase from the pinion angle) means nothing once the gears have mo
 
 
 def _check_mesh_range(scenario: Scenario, result: Result) -> None:
+    """Every mesh of every stage within its range (each kind's ``check_result``)."""
     for k, st in enumerate(scenario.stages):
-        if not hasattr(st, "pinion"):
-            _check_planetary_mesh_range(k, st, result)
-            continue
-        prefix = stage_prefix(k)
-        delta = np.abs(result[prefix + "mesh_deflection_m"])
-        p_b = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
-        if delta.max() > MAX_DEFLECTION_BASE_PITCH * p_b:
-            m = int(np.argmax(delta > MAX_DEFLECTION_BASE_PITCH * p_b))
-            hint = mesh_range_hint(scenario, k, MAX_DEFLECTION_BASE_PITCH * p_b)
-            raise SimulationError(
-                f"stage {k + 1}: the mesh deflection reached {delta[m] * 1e3:.3g} mm at t = "
-                f"{result.time_s[m]:.6g} s, more than {MAX_DEFLECTION_BASE_PITCH:g} of the base pitch "
-                f"({p_b * 1e3:.3g} mm): the lumped mesh model is outside its range (the gears ran "
-                f"through each other). Hint: {hint}"
-            )
+        hook = stage_kind(st).check_result
+        if hook is not None:
+            hook(scenario, k, result)
 
 
-def _check_planetary_mesh_range(k: int, st, result: Result) -> None:
+def _check_parallel_mesh_range(scenario: Scenario, k: int, result: Result) -> None:
+    """The mesh deflection of parallel stage k within MAX_DEFLECTION_BASE_PITCH of the base pitch."""
+    st = scenario.stages[k]
+    prefix = stage_prefix(k)
+    delta = np.abs(result[prefix + "mesh_deflection_m"])
+    p_b = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
+    if delta.max() > MAX_DEFLECTION_BASE_PITCH * p_b:
+        m = int(np.argmax(delta > MAX_DEFLECTION_BASE_PITCH * p_b))
+        hint = mesh_range_hint(scenario, k, MAX_DEFLECTION_BASE_PITCH * p_b)
+        raise SimulationError(
+            f"stage {k + 1}: the mesh deflection reached {delta[m] * 1e3:.3g} mm at t = "
+            f"{result.time_s[m]:.6g} s, more than {MAX_DEFLECTION_BASE_PITCH:g} of the base pitch "
+            f"({p_b * 1e3:.3g} mm): the lumped mesh model is outside its range (the gears ran "
+            f"through each other). Hint: {hint}"
+        )
+
+
+def _check_planetary_mesh_range(scenario: Scenario, k: int, result: Result) -> None:
     """Every planet mesh of planetary stage k within MAX_DEFLECTION_BASE_PITCH of the base pitch."""
+    st = scenario.stages[k]
     prefix = stage_prefix(k)
     p_b = math.pi * st.module_mm * 1e-3 * math.cos(math.radians(st.pressure_angle_deg))
     limit = MAX_DEFLECTION_BASE_PITCH * p_b
@@ -186,3 +194,7 @@ def _check_planetary_mesh_range(k: int, st, result: Result) -> None:
 
 
 __all__ = ["SimulationError", "build", "simulate", "solver_settings", "mesh_frequency_hz"]
+
+
+register_stage_kind("parallel", check_result=_check_parallel_mesh_range)
+register_stage_kind("planetary", check_result=_check_planetary_mesh_range)

@@ -25,23 +25,38 @@ class StageKind:
     - ``compound``: True when the stage needs the compound layout (its members are planar bodies in the
       drive's coordinates, :mod:`gearbody.assembly.compound`); parallel stages are not.
     - ``check(k, scenario)``: refuses what a drive with this stage at index k cannot have.
+    - ``resolve_geometry(stage, k)`` and ``resolve_rating(stage, k, rated_force_N)``: the stage with
+      what its table states indirectly resolved (gear geometry; then what depends on its rated force).
     - ``layout_part(scenario, k, first, modal)``: the stage's part of the compound layout, starting at
-      coordinate ``first`` (an object with ``names``, ``ends``, ``bodies()``, ``supports()``,
-      ``modal_items(system, bearing_states)``, ``drive_meshes()`` and ``drive_terms()``).
+      coordinate ``first``: an object with ``stage``, ``first``, ``coordinate_names``, ``ends`` (input
+      coordinate, its sense, output coordinate, its sense), ``bodies()``, ``supports()``,
+      ``modal_items(system, bearing_states)``, ``drive_meshes()`` and ``drive_terms()`` (the types of
+      :mod:`gearbody.assembly.system`).
     - ``input_name(scenario, k)``: the coordinate name of the stage's input rotation.
     - ``metadata(scenario, k)``: the stage's entry of ``Result.meta["stages"]``.
+    - ``signals(scenario, k, names, t, q, v, a)``: the stage's signals (by name) on recorded states
+      (rows of q, v, a in the order of ``names``); names follow :mod:`gearbody.signals`.
     - ``jump_times(scenario, k, names, t, q, v, signals)``: the times at which the stage's mesh laws
       jump on the recorded states (for the anti-aliasing of the output).
+    - ``stiffness_jumps(stage, k)``: lines naming the stage's meshes whose stiffness jumps sharply (the
+      hint of a stalled run).
+    - ``check_result(scenario, k, result)``: raises SimulationError where the run left the stage's model
+      range (a mesh deflection beyond its validity, say).
     """
 
     name: str
     model: type
     compound: bool = False
     check: Callable | None = None
+    resolve_geometry: Callable | None = None
+    resolve_rating: Callable | None = None
     layout_part: Callable | None = None
     input_name: Callable | None = None
     metadata: Callable | None = None
+    signals: Callable | None = None
     jump_times: Callable | None = None
+    stiffness_jumps: Callable | None = None
+    check_result: Callable | None = None
 
 
 _KINDS: dict[str, StageKind] = {}

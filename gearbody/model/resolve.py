@@ -218,46 +218,56 @@ def resolve_planetary_iso(stage, rated_force_N: float, k: int):
 
 
 def resolve_design(design):
-    """The design with every stage's [geometry] resolved: gears and mesh (base radii, contact ratio,
-    pitch point, backlash, stiffness), then the ISO stiffness at each stage's rated force, and the
-    damaged teeth checked against the stiffness profile they need. Pure: returns a new Design."""
+    """The design with every stage resolved by its kind (``resolve_geometry``, then ``resolve_rating`` at
+    its rated force): a parallel stage's gears and mesh (base radii, contact ratio, pitch point,
+    backlash, stiffness), then the ISO stiffness at each stage's rated force, and the damaged teeth
+    checked against the stiffness profile they need. Pure: returns a new Design."""
+    from .kinds import stage_kind
+
     stages = []
     for k, st in enumerate(design.stages):
-        if not hasattr(st, "pinion"):  # a planetary stage: its geometry is its own (checked when built)
-            stages.append(st)
-            continue
-        p, w, m = resolve_stage_geometry(st.pinion, st.wheel, st.mesh, stage_key(k, "mesh."))
-        stages.append(dataclasses.replace(st, pinion=p, wheel=w, mesh=m))
+        hook = stage_kind(st).resolve_geometry
+        stages.append(st if hook is None else hook(st, k))
     design = dataclasses.replace(design, stages=tuple(stages))
     for k, st in enumerate(design.stages):
-        if not hasattr(st, "pinion"):
-            stages[k] = resolve_planetary_iso(st, design.stage_rated_force_N(k), k)
-            continue
-        where = stage_key(k, "mesh.")
-        if st.mesh.stiffness_profile == "iso-6336-b":
-            mesh = resolve_iso_stiffness(
-                st.mesh, st.pinion.teeth, st.wheel.teeth, design.stage_rated_force_N(k), where
-            )
-            stages[k] = dataclasses.replace(st, mesh=mesh)
-        for tooth in st.damaged_teeth:
-            if tooth.has_geometric_damage and st.mesh.stiffness_profile != "potential-energy":
-                raise ScenarioError(
-                    f"{stage_key(k, 'damaged_teeth')}: {tooth.gear} tooth {tooth.tooth} has a crack, "
-                    f"breakage or spall; these need {where}stiffness_profile = 'potential-energy' (got "
-                    f"{st.mesh.stiffness_profile!r})"
-                )
-        if st.mesh.stiffness_profile == "potential-energy" and any(
-            t.has_geometric_damage for t in st.damaged_teeth
-        ):
-            from ..physics.mesh_stiffness import stage_pair_table
-
-            try:
-                stage_pair_table(st)
-            except ValueError as exc:
-                raise ScenarioError(f"{stage_key(k, 'damaged_teeth')}: {exc}") from None
-            except ArithmeticError:
-                raise ScenarioError(
-                    f"{stage_key(k, 'damaged_teeth')}: the damaged teeth's potential-energy stiffness "
-                    "overflows; check their damage sizes and the mesh's geometry"
-                ) from None
+        hook = stage_kind(st).resolve_rating
+        if hook is not None:
+            stages[k] = hook(st, k, design.stage_rated_force_N(k))
     return dataclasses.replace(design, stages=tuple(stages))
+
+
+def resolve_parallel_geometry(st, k: int):
+    """A parallel stage with its [geometry] resolved: gears and mesh."""
+    p, w, m = resolve_stage_geometry(st.pinion, st.wheel, st.mesh, stage_key(k, "mesh."))
+    return dataclasses.replace(st, pinion=p, wheel=w, mesh=m)
+
+
+def resolve_parallel_rating(st, k: int, rated_force_N: float):
+    """A parallel stage with its ISO stiffness at its rated force, its damaged teeth checked."""
+    where = stage_key(k, "mesh.")
+    resolved = st
+    if st.mesh.stiffness_profile == "iso-6336-b":
+        mesh = resolve_iso_stiffness(st.mesh, st.pinion.teeth, st.wheel.teeth, rated_force_N, where)
+        resolved = dataclasses.replace(st, mesh=mesh)
+    for tooth in st.damaged_teeth:
+        if tooth.has_geometric_damage and st.mesh.stiffness_profile != "potential-energy":
+            raise ScenarioError(
+                f"{stage_key(k, 'damaged_teeth')}: {tooth.gear} tooth {tooth.tooth} has a crack, "
+                f"breakage or spall; these need {where}stiffness_profile = 'potential-energy' (got "
+                f"{st.mesh.stiffness_profile!r})"
+            )
+    if st.mesh.stiffness_profile == "potential-energy" and any(
+        t.has_geometric_damage for t in st.damaged_teeth
+    ):
+        from ..physics.mesh_stiffness import stage_pair_table
+
+        try:
+            stage_pair_table(st)
+        except ValueError as exc:
+            raise ScenarioError(f"{stage_key(k, 'damaged_teeth')}: {exc}") from None
+        except ArithmeticError:
+            raise ScenarioError(
+                f"{stage_key(k, 'damaged_teeth')}: the damaged teeth's potential-energy stiffness "
+                "overflows; check their damage sizes and the mesh's geometry"
+            ) from None
+    return resolved

@@ -25,7 +25,7 @@ from .mesh import Mesh
 from .operation import Operation
 from .params import Node, ScenarioError, param, stage_key
 from .planetary import PlanetaryStage
-from .resolve import resolve_design
+from .resolve import resolve_design, resolve_parallel_geometry, resolve_parallel_rating, resolve_planetary_iso
 
 TOPOLOGIES = ("muller", "two-wheel", "train")
 
@@ -414,5 +414,17 @@ def _check_turning_senses(stages: tuple[Stage, ...]) -> None:
         sense = -sense
 
 
-register_stage_kind("parallel", Stage, check=lambda k, scenario: _check_stage(k, scenario.stages[k]))
-register_stage_kind("planetary", PlanetaryStage, compound=True, check=_check_planetary_in_drive)
+register_stage_kind(
+    "parallel",
+    Stage,
+    check=lambda k, scenario: _check_stage(k, scenario.stages[k]),
+    resolve_geometry=resolve_parallel_geometry,
+    resolve_rating=resolve_parallel_rating,
+)
+register_stage_kind(
+    "planetary",
+    PlanetaryStage,
+    compound=True,
+    check=_check_planetary_in_drive,
+    resolve_rating=lambda stage, k, rated_force_N: resolve_planetary_iso(stage, rated_force_N, k),
+)
