@@ -32,6 +32,8 @@ class BeltStage(Node):
     belt_damping_Ns_per_m: float = param(200.0, ge=0)
     transition_width: ClassVar[float] = 0.0
     coordinate_count: ClassVar[int] = 2
+    mesh_count: ClassVar[int] = 0
+    input_teeth: ClassVar[int] = 1  # no teeth: no mesh period shorter than a revolution
 
     @property
     def ratio(self) -> float:

@@ -22,7 +22,6 @@ import numpy as np
 from ..errors import InputError
 from ..model import Scenario
 from ..model.kinds import register_stage_kind, stage_kind
-from ..model.planetary import PlanetaryStage
 from ..physics.mesh import I_R1, I_R2, mean_stiffness_N_per_m
 from .operating_point import static_deflection_m, steady_operating_point
 from .parameters import mesh_parameters_from_scenario, pack_drive_parameters
@@ -209,20 +208,13 @@ def compound_initial_state(scenario: Scenario, layout: CompoundLayout) -> tuple[
                 "steady start; use operation.initial_state = 'rest'"
             )
     first = scenario.stages[0]
-    pitch_rad = (
-        2 * math.pi / (first.pinion.teeth if not isinstance(first, PlanetaryStage) else _input_teeth(first))
-    )
+    pitch_rad = 2 * math.pi / first.input_teeth
     for shift in START_SHIFTS:
         try:
             return _steady_state(scenario, layout, shift * pitch_rad)
         except InputError as exc:
             if "no static equilibrium" not in str(exc) or shift == START_SHIFTS[-1]:
                 raise
-
-
-def _input_teeth(stage: PlanetaryStage) -> int:
-    """Teeth that set the mesh period along the input member's angle (the carrier: the ring's)."""
-    return stage.sun.teeth if stage.input == "sun" else stage.ring.teeth
 
 
 def _steady_state(scenario: Scenario, layout: CompoundLayout, start_angle_rad: float):

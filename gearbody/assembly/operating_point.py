@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..model import Scenario
-from ..model.planetary import PlanetaryStage
+from ..model.kinds import register_stage_kind, stage_kind
 from ..physics.lateral import mesh_directions, static_bearing_displacement_m
 from ..physics.mesh import effective_stiffness_series, pair_in_mesh
 from ..physics.motor import steady_slip
@@ -154,18 +154,27 @@ def nominal_speeds_rad_s(scenario: Scenario) -> dict[str, float]:
     w = scenario.design.motor.synchronous_speed_rad_s
     out = {"motor": w} if scenario.meta.topology == "train" else {}
     for k, st in enumerate(scenario.stages):
-        if isinstance(st, PlanetaryStage):
-            prefix = stage_prefix(k)
-            willis = st.speeds(w)
-            for member in ("sun", "ring", "carrier"):
-                out[prefix + member] = st.input_sense * willis.of(member)
-            for n in range(st.planets):
-                out[f"{prefix}planet_{n + 1}"] = st.input_sense * willis.planet_rad_s
-        else:
-            pname, wname = gear_names(k)
-            out[pname] = w
-            out[wname] = w * st.input_arm_m / st.output_arm_m
+        hook = stage_kind(st).nominal_speeds
+        out.update(hook(st, k, w) if hook is not None else {})
         w = w * st.input_arm_m / st.output_arm_m
     if scenario.meta.topology == "train":
         out["machine"] = w
     return out
+
+
+def _parallel_speeds(st, k: int, w: float) -> dict[str, float]:
+    pname, wname = gear_names(k)
+    return {pname: w, wname: w * st.input_arm_m / st.output_arm_m}
+
+
+def _planetary_speeds(st, k: int, w: float) -> dict[str, float]:
+    prefix = stage_prefix(k)
+    willis = st.speeds(w)
+    out = {prefix + member: st.input_sense * willis.of(member) for member in ("sun", "ring", "carrier")}
+    for n in range(st.planets):
+        out[f"{prefix}planet_{n + 1}"] = st.input_sense * willis.planet_rad_s
+    return out
+
+
+register_stage_kind("parallel", nominal_speeds=_parallel_speeds)
+register_stage_kind("planetary", nominal_speeds=_planetary_speeds)

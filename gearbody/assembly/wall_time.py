@@ -116,8 +116,7 @@ def mesh_frequency_sum_hz(scenario: Scenario) -> float:
     speed = scenario.design.motor.synchronous_speed_rad_s * mean_speed_fraction(scenario)
     total = 0.0
     for st in scenario.stages:
-        meshes = 2 * st.planets if hasattr(st, "planets") else 1
-        total += meshes * st.mesh_frequency_hz(speed)
+        total += st.mesh_count * st.mesh_frequency_hz(speed)
         speed /= st.ratio
     return total
 

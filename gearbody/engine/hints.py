@@ -31,15 +31,18 @@ def _softest_stiffness_N_per_m(scenario: Scenario, stage: int) -> float:
     return mean_stiffness_N_per_m(mesh_parameters_from_scenario(scenario, stage))
 
 
-def _parallel(scenario: Scenario) -> list[tuple[int, object]]:
-    """(index, stage) of the parallel stages (a planetary stage has its own meshes, no pinion)."""
-    return [(k, st) for k, st in enumerate(scenario.stages) if hasattr(st, "pinion")]
-
-
 def _zero_factor_teeth(scenario: Scenario) -> list[str]:
+    """Every stage's teeth of stiffness factor 0 next to loaded ones (its kind's ``zero_factor_teeth``)."""
+    out = []
+    for k, st in enumerate(scenario.stages):
+        hook = stage_kind(st).zero_factor_teeth
+        out += hook(st, k) if hook is not None else []
+    return out
+
+
+def _parallel_zero_factor_teeth(st, k: int) -> list[str]:
     return [
         f"{stage_key(k, 'damaged_teeth')} ({t.gear} tooth {t.tooth})"
-        for k, st in _parallel(scenario)
         for t in st.damaged_teeth
         if t.stiffness_factor == 0
     ]
@@ -66,7 +69,18 @@ def _planetary_jumps(st, k: int) -> list[str]:
     ]
 
 
-register_stage_kind("parallel", stiffness_jumps=_parallel_jumps)
+def _parallel_divergence_cause(scenario: Scenario, k: int) -> str:
+    st = scenario.stages[k]
+    p_b_m = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
+    return _mesh_cause(scenario, k, 0.1 * p_b_m)
+
+
+register_stage_kind(
+    "parallel",
+    stiffness_jumps=_parallel_jumps,
+    zero_factor_teeth=_parallel_zero_factor_teeth,
+    divergence_cause=_parallel_divergence_cause,
+)
 register_stage_kind("planetary", stiffness_jumps=_planetary_jumps)
 
 
@@ -97,9 +111,9 @@ def stall_hint(scenario: Scenario) -> str:
 
 def divergence_hint(scenario: Scenario) -> str:
     """Hint of a diverged run: a mesh that cannot carry the load, else the usual suspects."""
-    for k, st in _parallel(scenario):
-        p_b_m = 2 * math.pi * st.pinion.base_radius_m / st.pinion.teeth
-        cause = _mesh_cause(scenario, k, 0.1 * p_b_m)
+    for k, st in enumerate(scenario.stages):
+        hook = stage_kind(st).divergence_cause
+        cause = hook(scenario, k) if hook is not None else ""
         if cause:
             return cause
     return "check stiffness, inertia and load values, or tighten solver tolerances / lower solver.max_step_s"

@@ -75,7 +75,7 @@ def signal_count(scenario: Scenario) -> int:
     gears = [g for st in scenario.parallel_stages for g in (st.pinion, st.wheel)]
     rotations = coordinates(scenario) - sum(len(g.free_directions) for g in gears)
     lateral = sum(3 * len(g.free_directions) + 4 for g in gears if g.lateral != "none")
-    meshes = len(gears) // 2 + sum(2 * st.planets for st in scenario.stages if hasattr(st, "planets"))
+    meshes = sum(st.mesh_count for st in scenario.stages)
     return 3 * rotations + 10 * meshes + 2 + lateral
 
 

@@ -21,7 +21,8 @@ class StageKind:
 
     - ``model``: the stage's dataclass (a :class:`gearbody.model.params.Node` with a ``KIND`` class
       variable equal to ``name``); it provides ``ratio``, ``input_arm_m``, ``output_arm_m``,
-      ``transition_width``, ``mesh_frequency_hz(input_speed_rad_s)`` and ``coordinate_count``.
+      ``transition_width``, ``mesh_frequency_hz(input_speed_rad_s)``, ``coordinate_count``, ``mesh_count``
+      and ``input_teeth`` (the teeth that set the mesh period along the input's angle).
     - ``compound``: True when the stage needs the compound layout (its members are planar bodies in the
       drive's coordinates, :mod:`gearbody.assembly.compound`); parallel stages are not.
     - ``check(k, scenario)``: refuses what a drive with this stage at index k cannot have.
@@ -39,7 +40,10 @@ class StageKind:
     - ``jump_times(scenario, k, names, t, q, v, signals)``: the times at which the stage's mesh laws
       jump on the recorded states (for the anti-aliasing of the output).
     - ``stiffness_jumps(stage, k)``: lines naming the stage's meshes whose stiffness jumps sharply (the
-      hint of a stalled run).
+      hint of a stalled run); ``zero_factor_teeth(stage, k)``: its teeth of stiffness factor 0, named
+      by key (ditto); ``divergence_cause(scenario, k)``: why the stage's model may have diverged, or "".
+    - ``nominal_speeds(stage, k, input_speed_rad_s)``: {rotation name: speed} of its rotations when its
+      input turns at ``input_speed_rad_s`` and nothing deflects (for the rotation-direction summary).
     - ``check_result(scenario, k, result)``: raises SimulationError where the run left the stage's model
       range (a mesh deflection beyond its validity, say).
     """
@@ -56,7 +60,10 @@ class StageKind:
     signals: Callable | None = None
     jump_times: Callable | None = None
     stiffness_jumps: Callable | None = None
+    zero_factor_teeth: Callable | None = None
+    divergence_cause: Callable | None = None
     check_result: Callable | None = None
+    nominal_speeds: Callable | None = None
 
 
 _KINDS: dict[str, StageKind] = {}

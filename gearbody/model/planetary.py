@@ -378,6 +378,16 @@ class PlanetaryStage(Node):
         """x, y and rotation of sun, ring, carrier and every planet."""
         return 3 * (3 + self.planets)
 
+    @property
+    def mesh_count(self) -> int:
+        """Meshes of the stage: every planet's sun and ring mesh."""
+        return 2 * self.planets
+
+    @property
+    def input_teeth(self) -> int:
+        """Teeth that set the mesh period along the input member's angle (the carrier: the ring's)."""
+        return self.sun.teeth if self.input == "sun" else self.ring.teeth
+
 
 def _stage_geometry_message(text: str, angles_deg: Sequence[float] = ()) -> str:
     """A PlanetaryGeometry message in the stage's own key names: ``planet_angles_rad[k] = <rad>`` (0-based,

@@ -71,6 +71,16 @@ class Stage(Node):
         return self.mesh.transition_width
 
     @property
+    def mesh_count(self) -> int:
+        """Meshes of the stage: one."""
+        return 1
+
+    @property
+    def input_teeth(self) -> int:
+        """Teeth that set the mesh period along the input's angle: the pinion's."""
+        return self.pinion.teeth
+
+    @property
     def input_arm_m(self) -> float:
         """The pinion's base radius: torque in per unit mesh force (as a planetary stage's r_eq)."""
         return self.pinion.base_radius_m
