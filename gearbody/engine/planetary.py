@@ -5,9 +5,10 @@ the central members' supports are coordinate spring-dampers to the ground; every
 its bearing on the carrier are one ``ObjectGenericODE2`` on all the stage's nodes calling the compiled
 :func:`gearbody.physics.planetary_mesh.stage_forces` (one Python call per right-hand side). Exudyn's
 planar rigid-body equations carry the planets' centripetal and Coriolis effects; nothing is linearised.
+Built, as every drive, by :func:`gearbody.engine.build.build` from a system layout.
 
-Node coordinates are displacements from the nominal assembly (reference coordinates: the planets'
-centres on the carrier circle); the user functions add the reference to get absolute coordinates.
+Node coordinates are displacements from the nominal assembly (the planets' centres on the carrier circle,
+:attr:`PlanetarySystem.reference`); the user functions add the reference to get absolute coordinates.
 """
 
 from __future__ import annotations
@@ -16,26 +17,14 @@ from dataclasses import dataclass, field
 
 import exudyn as exu
 import numpy as np
-from exudyn.itemInterface import (
-    LoadCoordinate,
-    MarkerNodeCoordinate,
-    NodePointGround,
-    NodeRigidBody2D,
-    ObjectConnectorCoordinateSpringDamper,
-    ObjectGenericODE2,
-    ObjectRigidBody2D,
-    SensorNode,
-    VObjectGenericODE2,
-)
 
 from ..assembly.planetary_layout import CENTRAL, PlanetaryLayout, rigid_speeds_rad_s
+from ..assembly.system import Body, ForceItem, Spring, SystemLayout
+from ..physics.compiled import compiled
 from ..physics.planetary_mesh import planet_forces, stage_forces
-from .user_functions import compiled
+from .build import build
 
 __all__ = ["PlanetarySystem", "build_planetary", "planetary_mesh_forces", "solve_planetary"]
-
-OVT = exu.OutputVariableType
-HIDDEN = VObjectGenericODE2(show=False)
 
 
 @dataclass
@@ -63,83 +52,77 @@ def build_planetary(
     carrier_speed_rad_s: float = 0.0,
 ) -> PlanetarySystem:
     """The stage at its nominal assembly, moving rigidly at the sun's and the carrier's speed (the ring
-    and planets by rigid rolling), with constant ``torques_Nm`` on sun, ring or carrier."""
-    SC = exu.SystemContainer()
-    mbs = SC.AddSystem()
-    speeds = rigid_speeds_rad_s(layout, sun_speed_rad_s, carrier_speed_rad_s)
-    ground = mbs.AddNode(NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
-    ground_marker = [mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=d)) for d in (0, 1)]
-    nodes, reference = {}, {}
-
-    def add_member(name: str, member, centre, spin_rad_s: float, centre_velocity) -> int:
-        ref = np.array([centre[0], centre[1], 0.0])
-        node = mbs.AddNode(
-            NodeRigidBody2D(
-                referenceCoordinates=ref.tolist(),
-                initialCoordinates=[0.0, 0.0, 0.0],
-                initialVelocities=[float(centre_velocity[0]), float(centre_velocity[1]), float(spin_rad_s)],
-            )
-        )
-        mbs.AddObject(ObjectRigidBody2D(nodeNumber=node, mass=member.mass_kg, inertia=member.inertia_kg_m2))
-        nodes[name], reference[name] = node, ref
-        return node
-
-    for name, member in zip(CENTRAL, layout.members, strict=True):
-        node = add_member(name, member, (0.0, 0.0), speeds[name], (0.0, 0.0))
-        markers = [mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=d)) for d in (0, 1, 2)]
-        for d in (0, 1):
-            mbs.AddObject(
-                ObjectConnectorCoordinateSpringDamper(
-                    markerNumbers=[ground_marker[d], markers[d]],
-                    stiffness=member.bearing_stiffness_N_per_m,
-                    damping=member.bearing_damping_Ns_per_m,
-                )
-            )
-        if member.torsion_stiffness_Nm_per_rad is not None:
-            mbs.AddObject(
-                ObjectConnectorCoordinateSpringDamper(
-                    markerNumbers=[ground_marker[0], markers[2]],  # ground coordinate 0 is fixed at 0
-                    stiffness=member.torsion_stiffness_Nm_per_rad,
-                    damping=member.torsion_damping_Nms_per_rad,
-                )
-            )
-        torque = (torques_Nm or {}).get(name, 0.0)
-        if torque:
-            mbs.AddLoad(LoadCoordinate(markerNumber=markers[2], load=float(torque)))
+    and planets by rigid rolling), with constant ``torques_Nm`` on sun, ring or carrier; built by the one
+    builder (:func:`gearbody.engine.build.build`) from its :class:`~gearbody.assembly.system.SystemLayout`."""
     unknown = set(torques_Nm or {}) - set(CENTRAL)
     if unknown:
         raise ValueError(f"torques_Nm: {sorted(unknown)} are not sun, ring or carrier")
+    speeds = rigid_speeds_rad_s(layout, sun_speed_rad_s, carrier_speed_rad_s)
+    names = [*CENTRAL, *_planet_names(layout)]
+    members = [*layout.members, *([layout.planet] * len(layout.planet_angles_rad))]
+    bodies = tuple(Body("planar", inertia_kg_m2=m.inertia_kg_m2, mass_kg=m.mass_kg) for m in members)
+    reference = {name: np.zeros(3) for name in CENTRAL}
+    v0 = np.zeros(3 * len(names))
+    for m, name in enumerate(CENTRAL):
+        v0[3 * m + 2] = speeds[name]
     wc = speeds["carrier"]
     for n, name in enumerate(_planet_names(layout)):
         x, y = layout.planet_centre_m(n)
-        add_member(name, layout.planet, (x, y), speeds["planet"], (-wc * y, wc * x))
-    names = [*CENTRAL, *_planet_names(layout)]
+        reference[name] = np.array([x, y, 0.0])
+        v0[9 + 3 * n : 12 + 3 * n] = (-wc * y, wc * x, speeds["planet"])
+    items: list = []
+    for m, (name, member) in enumerate(zip(CENTRAL, layout.members, strict=True)):
+        o = 3 * m
+        items += [
+            Spring(None, o + d, member.bearing_stiffness_N_per_m, member.bearing_damping_Ns_per_m)
+            for d in (0, 1)
+        ]
+        if member.torsion_stiffness_Nm_per_rad is not None:
+            items.append(
+                Spring(None, o + 2, member.torsion_stiffness_Nm_per_rad, member.torsion_damping_Nms_per_rad)
+            )
+        torque = float((torques_Nm or {}).get(name, 0.0))
+        if torque:
+            items.append(ForceItem((m,), _constant_torque(torque)))
     ref = np.concatenate([reference[k] for k in names])
-    G = np.array([layout.geometry(n) for n in range(len(layout.planet_angles_rad))])
-    P_s, P_r = layout.sun_mesh, layout.ring_mesh
-    forces = compiled(stage_forces, ref, ref, G, P_s, P_r)
-
-    def stage_items(mbs, t, itemNumber, q, q_t):
-        return forces(np.asarray(q) + ref, np.asarray(q_t), G, P_s, P_r)
-
-    size = 3 * len(names)
-    mbs.AddObject(
-        ObjectGenericODE2(
-            nodeNumbers=[nodes[k] for k in names],
-            massMatrix=np.zeros((size, size)),
-            forceUserFunction=stage_items,
-            visualization=HIDDEN,
-        )
+    items.append(ForceItem(tuple(range(len(names))), _stage_items(layout, ref)))
+    coordinates = tuple(c for name in names for c in (f"{name}_x", f"{name}_y", name))
+    built = build(SystemLayout(coordinates, bodies, tuple(items)), np.zeros(len(coordinates)), v0)
+    system = PlanetarySystem(
+        built.system_container, built.mbs, layout, dict(zip(names, built.nodes, strict=True)), reference
     )
-    system = PlanetarySystem(SC, mbs, layout, nodes, reference)
-    system.user_functions = [stage_items]
-    for name, node in nodes.items():
-        system.sensors[name] = {
-            kind: mbs.AddSensor(SensorNode(nodeNumber=node, outputVariableType=ovt, storeInternal=True))
-            for kind, ovt in (("q", OVT.Coordinates), ("v", OVT.Coordinates_t))
-        }
-    mbs.Assemble()
+    system.user_functions = built.user_functions
+    for i, name in enumerate(names):
+        system.sensors[name] = {kind: built.sensors[kind][i] for kind in ("q", "v")}
     return system
+
+
+def _constant_torque(torque_Nm: float):
+    """factory(watchdog) -> a constant torque on a planar body's rotation."""
+
+    def factory(watchdog):
+        def constant(mbs, t, itemNumber, q, q_t):
+            return [0.0, 0.0, torque_Nm]
+
+        return constant
+
+    return factory
+
+
+def _stage_items(layout: PlanetaryLayout, ref: np.ndarray):
+    """factory(watchdog) -> every planet's meshes and bearing on the stage's coordinates."""
+
+    def factory(watchdog):
+        G = np.array([layout.geometry(n) for n in range(len(layout.planet_angles_rad))])
+        P_s, P_r = layout.sun_mesh, layout.ring_mesh
+        forces = compiled(stage_forces, ref, ref, G, P_s, P_r)
+
+        def stage_items(mbs, t, itemNumber, q, q_t):
+            return forces(np.asarray(q) + ref, np.asarray(q_t), G, P_s, P_r)
+
+        return stage_items
+
+    return factory
 
 
 def solve_planetary(
