@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 import gearbody
-from gearbody.signals import gear_names, stage_file_tag, stage_prefix, stage_signal
+from gearbody.signals import gear_names, signal_unit, stage_file_tag, stage_prefix, stage_signal
 
 PACKAGE = Path(gearbody.__file__).parent
 COPIES = re.compile(r'f"_?stage_\{|f"(pinion|wheel)_\{')
@@ -45,3 +45,25 @@ def test_a_run_names_its_signals_by_the_rule():
         assert stage_signal("mesh_force_N", k) in result.names
         assert f"{gear_names(k)[0]}_angle_rad" in result.names
         assert result.stage_signal("kd", k).shape == result.time_s.shape
+    # every signal carries its unit in its name, or is one of the dimensionless kinds
+    dimensionless = re.compile(r"(^|_)(kd|mesh_phase|tooth)$")
+    unitless = [n for n in result.names if not signal_unit(n) and not dimensionless.search(n)]
+    assert unitless == []
+
+
+def test_the_unit_a_name_carries():
+    units = {
+        "pinion_accel_rad_s2": "rad/s^2",
+        "pinion_housing_accel_y_m_s2": "m/s^2",
+        "pinion_speed_rad_s": "rad/s",
+        "pinion_x_velocity_m_s": "m/s",
+        "pinion_angle_rad": "rad",
+        "motor_torque_Nm": "N m",
+        "stage_2_mesh_force_N": "N",
+        "mesh_deflection_m": "m",
+        "mesh_frequency_hz": "Hz",
+        "time_s": "s",
+        "kd": "",
+        "stage_2_planet_1_sun_mesh_phase": "",
+    }
+    assert {name: signal_unit(name) for name in units} == units

@@ -25,6 +25,7 @@ from gearbody.folders import write_text
 from gearbody.plotting.figure import png_base64
 from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure, tsa_figure
 from gearbody.result import Result
+from gearbody.signals import signal_unit
 
 __all__ = ["PEAK_COLUMNS", "report_sections", "spectrum_lines", "write_report"]
 
@@ -88,7 +89,7 @@ def report_sections(result: Result) -> dict[str, Any]:
     # the labelled spectrum of the vibration signal over the final window: Result.spectrum's, the one
     # composition of signal, window, lines and defaults
     labelled = result.spectrum(name)
-    unit = "rad/s^2" if name.endswith("rad_s2") else "m/s^2"
+    unit = signal_unit(name)
     peaks = labelled.peaks
     if f_mesh > 0:
         title = f"spectrum of {name} [{unit}], last {result.FINAL_FRACTION:.0%} of the run"
