@@ -179,8 +179,8 @@ def run_block(block: Block) -> Outcome:
     try:
         code = block.runnable_code()
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
-            if block.lang == "python":
-                exec(compile(code, block.where, "exec"), {"__name__": "__main__"})
+            if block.lang == "python":  # compiled as a user's script is: without this module's __future__
+                exec(compile(code, block.where, "exec", dont_inherit=True), {"__name__": "__main__"})
             else:
                 for words in block.commands(code):
                     if words[0] in PROVIDED:

@@ -161,7 +161,12 @@ def compound_layout(scenario: Scenario, *, modal: bool = False) -> CompoundLayou
     names: list[str] = ["motor"]
     parts = []
     for k, st in enumerate(scenario.stages):
-        part = stage_kind(st).layout_part(scenario, k, len(names), modal)
+        kind = stage_kind(st)
+        if kind.layout_part is None:
+            raise InputError(
+                f"stage {k + 1} (type {kind.name!r}): its kind has no layout part; it cannot be built"
+            )
+        part = kind.layout_part(scenario, k, len(names), modal)
         names += part.coordinate_names
         parts.append(part)
     names.append("machine")

@@ -23,8 +23,10 @@ class StageKind:
       variable equal to ``name``); it provides ``ratio``, ``input_arm_m``, ``output_arm_m``,
       ``transition_width``, ``mesh_frequency_hz(input_speed_rad_s)``, ``coordinate_count``, ``mesh_count``
       and ``input_teeth`` (the teeth that set the mesh period along the input's angle).
-    - ``compound``: True when the stage needs the compound layout (its members are planar bodies in the
-      drive's coordinates, :mod:`gearbody.assembly.compound`); parallel stages are not.
+    - ``compound``: True (the default) when a drive with this stage is built as a compound layout, the
+      motor, each stage's ``layout_part`` and the machine (:mod:`gearbody.assembly.compound`); only the
+      parallel stage is False: a drive of parallel stages alone has its own layout (lateral gears, the
+      two-wheel and Muller models, :mod:`gearbody.assembly.topology`).
     - ``check(k, scenario)``: refuses what a drive with this stage at index k cannot have.
     - ``resolve_geometry(stage, k)`` and ``resolve_rating(stage, k, rated_force_N)``: the stage with
       what its table states indirectly resolved (gear geometry; then what depends on its rated force).
@@ -50,7 +52,7 @@ class StageKind:
 
     name: str
     model: type
-    compound: bool = False
+    compound: bool = True
     check: Callable | None = None
     resolve_geometry: Callable | None = None
     resolve_rating: Callable | None = None

@@ -266,7 +266,9 @@ class Scenario(Node):
             )
         _check_topology(self.meta.topology, self.design)
         for k, stage in enumerate(self.stages):
-            stage_kind(stage).check(k, self)
+            check = stage_kind(stage).check
+            if check is not None:
+                check(k, self)
         if self.has_planetary:
             pass  # the turning sense of each member is the stage's own (docs/planetary.md)
         elif self.meta.topology == "train":
@@ -427,6 +429,7 @@ def _check_turning_senses(stages: tuple[Stage, ...]) -> None:
 register_stage_kind(
     "parallel",
     Stage,
+    compound=False,
     check=lambda k, scenario: _check_stage(k, scenario.stages[k]),
     resolve_geometry=resolve_parallel_geometry,
     resolve_rating=resolve_parallel_rating,
