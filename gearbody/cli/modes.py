@@ -56,17 +56,10 @@ def execute(args) -> int:
 
 
 def _first_stage_input(stage) -> tuple[float, str]:
-    """(mesh periods per revolution of the first stage's input, the table's footnote): the pinion's teeth
-    z1, or for a planetary first stage f_m / f_in of rigid rolling (Willis), f_m = z_s |w_s - w_c| / 2 pi."""
-    if getattr(stage, "type", "") != "planetary":
-        z1 = stage.pinion.teeth
-        return (
-            z1,
-            f"(w(k f_z) = pinion speed at which the k-th mesh harmonic z1 w k / 2 pi meets f_n; z1 = {z1})",
-        )
-    per_rev = 2 * math.pi * stage.mesh_frequency_hz(1.0)
+    """(mesh periods per revolution of the first stage's input, the table's footnote), from the stage
+    (its model's :meth:`mesh_periods_per_revolution`: a parallel stage's z1, a planetary one's f_m / f_in)."""
+    per_rev, how = stage.mesh_periods_per_revolution()
     return per_rev, (
-        f"(w(k f_z) = {stage.input} speed (the planetary first stage's input) at which the k-th mesh "
-        f"harmonic k f_m meets f_n; f_m = z_s |w_s - w_c| / 2 pi = {per_rev:.5g} w / 2 pi with the "
-        f"{stage.fixed} fixed, z_s/z_p/z_r = {stage.sun.teeth}/{stage.planet.teeth}/{stage.ring.teeth})"
+        "(w(k f_z) = speed of the first stage's input at which the k-th mesh harmonic k f_z = k "
+        f"{per_rev:.5g} w / 2 pi meets f_n; {how})"
     )

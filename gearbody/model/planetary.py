@@ -383,6 +383,15 @@ class PlanetaryStage(Node):
         """Meshes of the stage: every planet's sun and ring mesh."""
         return 2 * self.planets
 
+    def mesh_periods_per_revolution(self) -> tuple[float, str]:
+        """(mesh periods per revolution of the input member, how they follow from the stage): f_m / f_in
+        of rigid rolling (Willis), f_m = z_s |w_s - w_c| / 2 pi."""
+        per_rev = 2 * math.pi * self.mesh_frequency_hz(1.0)
+        return per_rev, (
+            f"f_m = z_s |w_s - w_c| / 2 pi = {per_rev:.5g} w / 2 pi with the {self.fixed} fixed, "
+            f"z_s/z_p/z_r = {self.sun.teeth}/{self.planet.teeth}/{self.ring.teeth}"
+        )
+
     @property
     def input_teeth(self) -> int:
         """Teeth that set the mesh period along the input member's angle (the carrier: the ring's)."""

@@ -80,6 +80,11 @@ class Stage(Node):
         """Teeth that set the mesh period along the input's angle: the pinion's."""
         return self.pinion.teeth
 
+    def mesh_periods_per_revolution(self) -> tuple[float, str]:
+        """(mesh periods per revolution of the input, how they follow from the stage): z1."""
+        z1 = self.pinion.teeth
+        return z1, f"the pinion's teeth z1 = {z1}"
+
     @property
     def input_arm_m(self) -> float:
         """The pinion's base radius: torque in per unit mesh force (as a planetary stage's r_eq)."""
