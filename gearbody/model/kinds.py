@@ -48,6 +48,13 @@ class StageKind:
       input turns at ``input_speed_rad_s`` and nothing deflects (for the rotation-direction summary).
     - ``check_result(scenario, k, result)``: raises SimulationError where the run left the stage's model
       range (a mesh deflection beyond its validity, say).
+    - ``render_parts(scenario, k)``: the stage's part of the 3D picture (:mod:`gearbody.render`): an
+      object with ``face_m`` (its axial room), ``ends`` (input body, its sense, output body, its sense),
+      ``mesh_pair`` (the bodies of its first mesh, or None), ``fixes_sense`` and ``input_sense``,
+      ``output_axis(xy)``, ``turn(sense)`` (its mirror and output sense), ``shaft_cap_m(end)`` and
+      ``bodies(drive)`` (see :mod:`gearbody.render.drive`); None: ``gearbody render`` refuses the drive.
+      Optionally ``render_parts.teeth(table)``: the teeth a saved stage table states (a tuple), by which
+      a result of another drive is refused.
     """
 
     name: str
@@ -66,6 +73,7 @@ class StageKind:
     divergence_cause: Callable | None = None
     check_result: Callable | None = None
     nominal_speeds: Callable | None = None
+    render_parts: Callable | None = None
 
 
 _KINDS: dict[str, StageKind] = {}

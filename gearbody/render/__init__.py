@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model import Scenario
-from ..model.planetary import PlanetaryStage
+from ..model import Scenario, scenario_to_dict
+from ..model.kinds import stage_kinds
 from ..result import Result
 from .layout import Layout, build_layout
 from .movie import FORMATS, ffmpeg_available, write_gif, write_mp4, write_png
@@ -64,7 +64,7 @@ def check_result_matches(scenario: Scenario, result: Result) -> None:
         return
     design = saved.get("design", {})
     stages = design.get("stages") or [{"pinion": design.get("pinion", {}), "wheel": design.get("wheel", {})}]
-    ours = [_teeth(st) for st in scenario.stages]
+    ours = [_teeth(st) for st in scenario_to_dict(scenario)["design"]["stages"]]
     theirs = [_teeth(st) for st in stages]
     if theirs != ours:
         raise RenderError(
@@ -73,17 +73,14 @@ def check_result_matches(scenario: Scenario, result: Result) -> None:
         )
 
 
-def _teeth(stage) -> tuple:
-    """A stage's teeth, of a Stage or PlanetaryStage or their saved dict: (pinion, wheel), or
-    ('planetary', sun, planet, ring, planets)."""
-    if isinstance(stage, dict):
-        if stage.get("type") == "planetary":
-            z = [stage.get(m, {}).get("teeth") for m in ("sun", "planet", "ring")]
-            return ("planetary", *z, stage.get("planets"))
-        return (stage.get("pinion", {}).get("teeth"), stage.get("wheel", {}).get("teeth"))
-    if isinstance(stage, PlanetaryStage):
-        return ("planetary", stage.sun.teeth, stage.planet.teeth, stage.ring.teeth, stage.planets)
-    return (stage.pinion.teeth, stage.wheel.teeth)
+def _teeth(table: dict) -> tuple:
+    """The teeth a stage table states, as its kind's render parts read them (``render_parts.teeth``:
+    (pinion, wheel), or ('planetary', sun, planet, ring, planets)); a kind without: its type alone.
+    A table without a type is of the first kind (as the scenario reads it)."""
+    kinds = {kind.name: kind for kind in stage_kinds()}
+    kind = kinds.get(table.get("type", stage_kinds()[0].name))
+    teeth = getattr(kind.render_parts, "teeth", None) if kind is not None else None
+    return teeth(table) if teeth is not None else (table.get("type"),)
 
 
 def _motion(scenario: Scenario, result: Result | None, layout: Layout, until_s: float = 0.0) -> Result:

@@ -1,5 +1,7 @@
-"""Where every part of a drive sits in 3D, derived from the scenario alone (no Exudyn). One concern, the
-placing rules, kept in one module (~400 lines) so that each size rule is stated once, where it is used.
+"""Where every part of a drive sits in 3D, derived from the scenario alone (no Exudyn): the drive's frame
+(stage planes, axes, walls, turning senses), the motor, the driven machine and the housing here; each
+stage's own bodies from its kind's ``render_parts`` (:mod:`gearbody.render.parallel`,
+:mod:`gearbody.render.planetary`), so that each size rule is stated once, where it is used.
 
 Gear axes are parallel to z. Stage s's wheel axis lies one centre distance a_s = r_1 + r_2 (pitch
 radii r = r_b / cos(alpha), standard gears without profile shift) from its pinion axis, in the
@@ -19,10 +21,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from ..errors import RenderError
 from ..model import Scenario
-from ..model.planetary import PlanetaryStage
-from ..physics.lateral import mesh_directions
-from ..signals import gear_names, stage_prefix
+from ..model.kinds import stage_kind
+from .drive import SHAFT_SHEAR_STRESS_PA, Bearings, Drive, hub, shaft_radius_m  # noqa: F401  (re-exported)
+from .parallel import module_m, tooth_angle_rad  # noqa: F401  (re-exported; registers the parallel parts)
+from .planetary import PlanetaryParts  # noqa: F401  (registers the planetary kind's render parts)
 from .shapes import (  # noqa: F401  (the parts are re-exported: render code and tests import them here)
     BASE,
     BEARING,
@@ -43,10 +47,6 @@ from .shapes import (  # noqa: F401  (the parts are re-exported: render code and
     Orbit,
     Prism,
 )
-
-#: allowable torsional shear stress for the drawn shaft diameters, d = (16 T / (pi tau))^(1/3)
-SHAFT_SHEAR_STRESS_PA = 30e6
-
 
 MESH_WINDOW_MODULES = 6.0
 """Half-size of the ``frame="mesh"`` camera box in modules: the teeth in contact and 2-3 pairs each side."""
@@ -147,53 +147,84 @@ class Layout:
         return (tuple(lo), tuple(hi))
 
 
-def module_m(base_radius_m: float, teeth: int, pressure_angle_deg: float) -> float:
-    """m = 2 r_b / (z cos alpha)."""
-    return 2 * base_radius_m / (teeth * math.cos(math.radians(pressure_angle_deg)))
-
-
-def shaft_radius_m(torque_Nm: float) -> float:
-    """Solid shaft sized for the torque: d = (16 T / (pi tau))^(1/3), tau = 30 MPa."""
-    return 0.5 * (16 * abs(torque_Nm) / (math.pi * SHAFT_SHEAR_STRESS_PA)) ** (1 / 3)
-
-
-def tooth_angle_rad(gear: str, tooth: int, teeth: int, sense: int, centre_line_rad: float) -> float:
-    """Body-frame angle of the centre of model tooth ``tooth`` (docs/render.md, "Teeth").
-
-    The model meshes pinion tooth i = floor(phi_p z1 / 2 pi) mod z1 with wheel tooth j = the same
-    pair count mod z2. The pinion tooth i is centred on the centre line in the middle of its mesh
-    period; the wheel tooth j sits half a pitch ahead of it in the direction of motion, so the drawn
-    teeth interleave.
-    """
-    pitch = 2 * math.pi / teeth
-    if gear == "pinion":
-        return centre_line_rad - sense * (tooth + 0.5) * pitch
-    return centre_line_rad + math.pi - sense * tooth * pitch
-
-
 def build_layout(scenario: Scenario) -> Layout:
     """The 3D layout of a scenario's drive (see the module docstring)."""
-    from .planetary import attach_z_m, side_depth_m, stage_bodies
-
-    stages = scenario.stages
+    parts = _render_parts(scenario)
+    drive = _drive(scenario, parts)
     d = scenario.design
-    planetary = [isinstance(st, PlanetaryStage) for st in stages]
-    mods = [
-        st.module_mm * 1e-3
-        if planetary[k]
-        else module_m(st.pinion.base_radius_m, st.pinion.teeth, st.mesh.pressure_angle_deg)
-        for k, st in enumerate(stages)
-    ]
-    widths = [
-        (10 * m, 10 * m)
-        if planetary[k]
-        else (st.pinion.face_width_m or 10 * m, st.wheel.face_width_m or 10 * m)
-        for k, (st, m) in enumerate(zip(stages, mods, strict=True))
-    ]
-    # a planetary stage's axial room includes its carrier plate (and a turning ring's drum)
-    faces = [
-        2 * side_depth_m(st, widths[k][0]) if planetary[k] else max(widths[k]) for k, st in enumerate(stages)
-    ]
+    layout = Layout(lateral_scale=scenario.visual.lateral_scale)
+    if parts[0].mesh_pair is not None:
+        layout.mesh_pair = parts[0].mesh_pair
+    power_kW = d.machine.rated_torque_Nm / scenario.gear_ratio * d.motor.synchronous_speed_rad_s / 1e3
+    frame_d = 0.13 * max(power_kW, 0.5) ** (1 / 3)  # IEC frame diameter ~ P^(1/3): 75 kW -> 0.55 m
+
+    # motor rotor: shaft stub and coupling half
+    z_motor = drive.z_cpl_in - drive.hub_len - 0.4 * drive.gap
+    motor_len = 1.8 * frame_d
+    first = drive.ends[0]
+    layout.bodies.append(
+        Body(
+            "motor",
+            drive.axes[0],
+            drive.senses[0],
+            "motor_angle_rad",
+            (
+                Cylinder(z_motor, drive.z_cpl_in - drive.hub_len, drive.r_in, SHAFT),
+                *hub(drive.z_cpl_in - drive.hub_len, drive.z_cpl_in - 0.002, drive.r_in),
+            ),
+            follows=first[0],
+            ratio=float(first[1]),
+        )
+    )
+    layout.input_signal, layout.input_factor = f"{first[0]}_angle_rad", first[1]
+
+    # each stage's bodies (gears with their shafts); bearings in both housing walls, once per axis
+    for part in parts:
+        layout.bodies.extend(part.bodies(drive))
+    layout.ground.extend(drive.bearings.parts(drive.axes, (drive.z_front, drive.z_back), drive.wall))
+
+    # driven machine: coupling half and shaft stub
+    r_out = min(shaft_radius_m(drive.torques[-1]), parts[-1].shaft_cap_m(1))
+    z_cpl_out = drive.output_coupling_z_m(r_out)
+    mach_d = 1.1 * frame_d
+    z_mach = z_cpl_out + 1.6 * r_out + 0.4 * drive.gap
+    last = drive.ends[-1]
+    layout.bodies.append(
+        Body(
+            "machine",
+            drive.axes[-1],
+            drive.senses[-1],
+            "machine_angle_rad",
+            (
+                *hub(z_cpl_out + 0.002, z_cpl_out + 1.6 * r_out, r_out),
+                Cylinder(z_cpl_out + 1.6 * r_out, z_mach, r_out, SHAFT),
+            ),
+            follows=last[2],
+            ratio=float(last[3]),
+        )
+    )
+    _frames(layout, scenario, drive, (z_motor, motor_len, frame_d), (z_mach, mach_d))
+    return layout
+
+
+def _render_parts(scenario: Scenario) -> list:
+    """Each stage's render parts, from its kind; a kind without them is refused in one line."""
+    parts = []
+    for k, st in enumerate(scenario.stages):
+        kind = stage_kind(st)
+        if kind.render_parts is None:
+            raise RenderError(
+                f"stage {k + 1} (type {kind.name!r}) has no 3D parts: its kind registers no render_parts, "
+                "so gearbody render cannot draw this drive"
+            )
+        parts.append(kind.render_parts(scenario, k))
+    return parts
+
+
+def _drive(scenario: Scenario, parts: list) -> Drive:
+    """The drive's frame: stage planes along +z, walls, axes, senses, rated torques, input coupling."""
+    stages = scenario.stages
+    faces = [p.face_m for p in parts]  # each stage's axial room
     gap = 0.5 * max(faces)
     z_stage = [0.0]  # axial position of each stage's mid-plane
     for k in range(1, len(stages)):
@@ -203,228 +234,39 @@ def build_layout(scenario: Scenario) -> Layout:
     z_back = z_stage[-1] + faces[-1] / 2 + gap + wall / 2
 
     # rated torque on each axis: the machine torque passed upstream through the ratios
-    torques = [d.machine.rated_torque_Nm]
+    torques = [scenario.design.machine.rated_torque_Nm]
     for st in reversed(stages):
         torques.insert(0, torques[0] / st.ratio)
-    axes = [(0.0, 0.0)]  # axis positions: one centre distance per stage along its centre line
-    for k, st in enumerate(stages):
-        if planetary[k]:  # coaxial: the output shaft continues the input's axis
-            axes.append(axes[-1])
-            continue
-        gam = math.radians(st.mesh.centre_line_deg)
-        a = (st.pinion.base_radius_m + st.wheel.base_radius_m) / math.cos(
-            math.radians(st.mesh.pressure_angle_deg)
-        )
-        axes.append((axes[-1][0] + a * math.cos(gam), axes[-1][1] + a * math.sin(gam)))
-    senses, mirrors = _axis_senses(stages)
-    names = [gear_names(k) for k in range(len(stages))]
-    # the bodies on each stage's input and output shaft, and their model angle per unit chain angle
-    # (a planetary member's angle is absolute, counter-clockwise: s_in or s_out times the chain's)
-    ends = []
-    for k, st in enumerate(stages):
-        if planetary[k]:
-            p = stage_prefix(k)
-            ends.append((p + st.input, st.input_sense, p + st.output, st.output_sense))
-        else:
-            ends.append((names[k][0], 1, names[k][1], 1))
-
-    def root_radius(gear, m):
-        return 0.5 * m * gear.teeth - 1.25 * m
-
-    def shaft_cap(k: int, end: int) -> float:
-        """Largest drawn radius of stage k's input (end 0) or output (end 1) shaft: 0.8 of its gear's
-        root radius (a planetary stage's sun; its ring or carrier: none)."""
-        st = stages[k]
-        if planetary[k]:
-            member = (st.input, st.output)[end]
-            return 0.8 * (0.5 * mods[k] * st.sun.teeth - 1.25 * mods[k]) if member == "sun" else math.inf
-        return 0.8 * root_radius((st.pinion, st.wheel)[end], mods[k])
-
-    def hub(z0, z1, r):
-        """Coupling half with a marker stripe that shows its rotation."""
-        return (
-            Cylinder(z0, z1, 1.9 * r, COUPLING),
-            Box((1.75 * r, 0.0, 0.5 * (z0 + z1)), (0.4 * r, 0.5 * r, 1.02 * abs(z1 - z0)), MARKER),
-        )
-
-    layout = Layout(lateral_scale=scenario.visual.lateral_scale)
-    if planetary[0]:
-        layout.mesh_pair = ("sun", "planet_1")
-    power_kW = d.machine.rated_torque_Nm / scenario.gear_ratio * d.motor.synchronous_speed_rad_s / 1e3
-    frame_d = 0.13 * max(power_kW, 0.5) ** (1 / 3)  # IEC frame diameter ~ P^(1/3): 75 kW -> 0.55 m
-
-    # motor rotor: shaft stub and coupling half
-    r_in = min(shaft_radius_m(torques[0]), shaft_cap(0, 0))
+    axes = [(0.0, 0.0)]  # axis positions: each stage places its output axis from its input axis
+    for p in parts:
+        axes.append(p.output_axis(axes[-1]))
+    senses, mirrors = _axis_senses(parts)
+    r_in = min(shaft_radius_m(torques[0]), parts[0].shaft_cap_m(0))
     hub_len = 1.6 * r_in
-    z_cpl_in = z_front - wall / 2 - 0.5 * gap - hub_len
-    z_motor = z_cpl_in - hub_len - 0.4 * gap
-    motor_len = 1.8 * frame_d
-    layout.bodies.append(
-        Body(
-            "motor",
-            axes[0],
-            senses[0],
-            "motor_angle_rad",
-            (
-                Cylinder(z_motor, z_cpl_in - hub_len, r_in, SHAFT),
-                *hub(z_cpl_in - hub_len, z_cpl_in - 0.002, r_in),
-            ),
-            follows=ends[0][0],
-            ratio=float(ends[0][1]),
-        )
-    )
-    layout.input_signal, layout.input_factor = f"{ends[0][0]}_angle_rad", ends[0][1]
-
-    # gears with their shafts; bearings in both housing walls, once per axis (coaxial axes share them)
-    axis_shaft_r: dict[int, float] = {}
-    wall_shaft_r: dict[int, list[float]] = {}  # an axis through a planetary stage: [front, back] shafts
-    axis_key = list(range(len(axes)))  # a planetary stage's output axis is its input axis
-
-    def add_planetary(k: int) -> None:
-        """Stage k's sun, ring, carrier and planets, its input shaft from the front (the coupling or
-        the middle between stages) and its output shaft to the back."""
-        st, b = stages[k], widths[k][0]
-        radius = {
-            st.input: min(shaft_radius_m(torques[k]), shaft_cap(k, 0)),
-            st.output: min(shaft_radius_m(torques[k + 1]), shaft_cap(k, 1)),
-        }
-        z_in, z_out = (attach_z_m(st, m, z_stage[k], b) for m in (st.input, st.output))
-        r_i, r_o = radius[st.input], radius[st.output]
-        if k == 0:
-            shaft_in = (
-                Cylinder(z_cpl_in, z_in, r_i, SHAFT),
-                *hub(z_cpl_in + 0.002, z_cpl_in + hub_len, r_in),
-            )
-        else:
-            shaft_in = (Cylinder(0.5 * (z_stage[k - 1] + z_stage[k]), z_in, r_i, SHAFT),)
-        if k == len(stages) - 1:
-            z_cpl_out = z_back + wall / 2 + 0.5 * gap + 1.6 * r_o
-            shaft_out = (
-                Cylinder(z_out, z_cpl_out, r_o, SHAFT),
-                *hub(z_cpl_out - 1.6 * r_o, z_cpl_out - 0.002, r_o),
-            )
-        else:
-            shaft_out = (Cylinder(z_out, 0.5 * (z_stage[k] + z_stage[k + 1]), r_o, SHAFT),)
-        follows = None if k == 0 else (ends[k - 1][2], float(st.input_sense * ends[k - 1][3]))
-        layout.bodies.extend(
-            stage_bodies(
-                st,
-                k,
-                axes[k],
-                z_stage[k],
-                b,
-                mirrors[k],
-                {st.input: shaft_in, st.output: shaft_out},
-                radius,
-                follows,
-            )
-        )
-        axis_key[k + 1] = axis_key[k]
-        key = axis_key[k]  # the front wall holds the axis's first shaft, the back wall this output's
-        front = wall_shaft_r[key][0] if key in wall_shaft_r else axis_shaft_r.get(key, r_i)
-        wall_shaft_r[key] = [front, r_o]
-        axis_shaft_r[key] = max(axis_shaft_r.get(key, 0.0), r_i, r_o)
-
-    for k, st in enumerate(stages):
-        if planetary[k]:
-            add_planetary(k)
-            continue
-        gam = math.radians(st.mesh.centre_line_deg)
-        m = mods[k]
-        marks = {(t.gear, t.tooth): DAMAGED for t in st.damaged_teeth if t.stiffness_factor < 1}
-        marks.update({(t.gear, t.tooth): PITTED for t in st.pitted_teeth if t.depth_um > 0})
-        for which, gear, b, colour in (
-            ("pinion", st.pinion, widths[k][0], STEEL),
-            ("wheel", st.wheel, widths[k][1], WHEEL),
-        ):
-            j = k if which == "pinion" else k + 1  # axis index
-            name = names[k][0 if which == "pinion" else 1]
-            shaft_r = min(shaft_radius_m(torques[j]), 0.8 * root_radius(gear, m))
-            shape = GearShape(
-                teeth=gear.teeth,
-                module_m=m,
-                pressure_angle_deg=st.mesh.pressure_angle_deg,
-                face_width_m=b,
-                z_m=z_stage[k],
-                bore_radius_m=0.98 * shaft_r,
-                first_tooth_rad=tooth_angle_rad(which, 0, gear.teeth, senses[j], gam),
-                colour=colour,
-                marked_teeth=tuple(
-                    (tooth_angle_rad(which, i, gear.teeth, senses[j], gam), c)
-                    for (g, i), c in sorted(marks.items())
-                    if g == which
-                ),
-            )
-            parts: list = [shape]
-            if which == "pinion" and k == 0:  # input shaft from the coupling through the box
-                parts += [
-                    Cylinder(z_cpl_in, z_back, shaft_r, SHAFT),
-                    *hub(z_cpl_in + 0.002, z_cpl_in + hub_len, r_in),
-                ]
-            elif which == "pinion":  # back half of the intermediate shaft
-                parts.append(Cylinder(0.5 * (z_stage[k - 1] + z_stage[k]), z_back, shaft_r, SHAFT))
-            elif k < len(stages) - 1:  # front half of the intermediate shaft
-                parts.append(Cylinder(z_front, 0.5 * (z_stage[k] + z_stage[k + 1]), shaft_r, SHAFT))
-            else:  # output shaft out of the back wall to the machine coupling
-                z_cpl_out = z_back + wall / 2 + 0.5 * gap + 1.6 * shaft_r
-                parts += [
-                    Cylinder(z_front, z_cpl_out, shaft_r, SHAFT),
-                    *hub(z_cpl_out - 1.6 * shaft_r, z_cpl_out - 0.002, shaft_r),
-                ]
-            follows, ratio = (
-                (None, 1.0)
-                if (which, k) == ("pinion", 0)
-                else (
-                    (names[k][0], st.pinion.teeth / st.wheel.teeth)
-                    if which == "wheel"
-                    else (ends[k - 1][2], float(ends[k - 1][3]))
-                )
-            )
-            lateral = (f"{name}_x_m", f"{name}_y_m") if gear.lateral != "none" else None
-            layout.bodies.append(
-                Body(name, axes[j], senses[j], f"{name}_angle_rad", tuple(parts), lateral, follows, ratio)
-            )
-            if axis_key[j] in wall_shaft_r and which == "pinion":  # after a planetary stage
-                wall_shaft_r[axis_key[j]][1] = shaft_r
-            axis_shaft_r[axis_key[j]] = max(axis_shaft_r.get(axis_key[j], 0.0), shaft_r)
-
-    for j, shaft_r in axis_shaft_r.items():
-        for w, zw in enumerate((z_front, z_back)):
-            if j in wall_shaft_r:
-                shaft_r = wall_shaft_r[j][w]
-            layout.ground.append(
-                Cylinder(
-                    zw - wall / 2,
-                    zw + wall / 2,
-                    1.8 * shaft_r,
-                    BEARING,
-                    inner_radius_m=1.05 * shaft_r,
-                    x_m=axes[j][0],
-                    y_m=axes[j][1],
-                )
-            )
-
-    # driven machine: coupling half and shaft stub
-    r_out = min(shaft_radius_m(torques[-1]), shaft_cap(len(stages) - 1, 1))
-    z_cpl_out = z_back + wall / 2 + 0.5 * gap + 1.6 * r_out
-    mach_d = 1.1 * frame_d
-    z_mach = z_cpl_out + 1.6 * r_out + 0.4 * gap
-    layout.bodies.append(
-        Body(
-            "machine",
-            axes[-1],
-            senses[-1],
-            "machine_angle_rad",
-            (
-                *hub(z_cpl_out + 0.002, z_cpl_out + 1.6 * r_out, r_out),
-                Cylinder(z_cpl_out + 1.6 * r_out, z_mach, r_out, SHAFT),
-            ),
-            follows=ends[-1][2],
-            ratio=float(ends[-1][3]),
-        )
+    return Drive(
+        stages=stages,
+        z_stage=z_stage,
+        z_front=z_front,
+        z_back=z_back,
+        wall=wall,
+        gap=gap,
+        axes=axes,
+        senses=senses,
+        mirrors=mirrors,
+        torques=torques,
+        # the bodies on each stage's input and output shaft, and their model angle per unit chain angle
+        ends=[p.ends for p in parts],
+        r_in=r_in,
+        z_cpl_in=z_front - wall / 2 - 0.5 * gap - hub_len,
+        hub_len=hub_len,
+        bearings=Bearings(list(range(len(axes)))),
     )
 
-    # housing, motor and machine frames standing on a base plate
+
+def _frames(layout: Layout, scenario: Scenario, drive: Drive, motor: tuple, machine: tuple) -> None:
+    """The housing, the motor and machine frames and the gearbox feet, standing on a base plate."""
+    (z_motor, motor_len, frame_d), (z_mach, mach_d) = motor, machine
+    z_front, z_back, wall, axes = drive.z_front, drive.z_back, drive.wall, drive.axes
     rmax = max(p.outer_radius_m for _, p in layout.gears)
     margin = 0.1 * rmax + 0.03
     xs, ys = [x for x, _ in axes], [y for _, y in axes]
@@ -464,30 +306,28 @@ def build_layout(scenario: Scenario) -> Layout:
     layout.ground.append(
         Box(((xlo + xhi) / 2, floor - 0.02, (zlo + zhi) / 2), (xhi - xlo, 0.04, zhi - zlo), BASE)
     )
-    return layout
 
 
-def _axis_senses(stages) -> tuple[list[int], list[int]]:
+def _axis_senses(parts: list) -> tuple[list[int], list[int]]:
     """Drawn turning sense of every axis (positive: counter-clockwise seen from the machine side) and
-    the mirror of every stage (-1: a planetary stage drawn mirrored, 1 otherwise).
+    the mirror of every stage (-1: a stage drawn mirrored, 1 otherwise).
 
-    Without planetary stages the input shaft turns as stage 1's line of action says (the lateral
-    models' convention) and every further axis the other way. With them, the first planetary stage's
-    input turns in its modelled sense s_in (parallel stages are then torsional, sense-free), the axes
-    before it alternating back to the motor; a later planetary stage whose input turns the other way
-    is drawn mirrored."""
-    first = next((k for k, st in enumerate(stages) if isinstance(st, PlanetaryStage)), None)
+    When no stage fixes the sense of its input (parallel stages: torsional ones are sense-free), the
+    input shaft turns as stage 1 says (its line of action: the lateral models' convention). Otherwise
+    the first stage that fixes it (a planetary stage: its modelled sense s_in) sets it, the axes before
+    it turning back to the motor; every stage turns its output from its input (a later planetary stage
+    whose input turns the other way is drawn mirrored)."""
+    first = next((k for k, p in enumerate(parts) if p.fixes_sense), None)
     if first is None:
-        senses = [mesh_directions(stages[0].mesh.centre_line_deg, stages[0].mesh.line_of_action_deg)[2]]
-        for _ in stages:
-            senses.append(-senses[-1])
-        return senses, [1] * len(stages)
-    senses, mirrors = [stages[first].input_sense * (-1) ** first], []
-    for st in stages:
-        if isinstance(st, PlanetaryStage):
-            mirrors.append(senses[-1] * st.input_sense)
-            senses.append(mirrors[-1] * st.output_sense)
-        else:
-            mirrors.append(1)
-            senses.append(-senses[-1])
+        sense = parts[0].input_sense
+    else:
+        chain = 1  # the sense at the first fixing stage's input per unit sense of the input shaft
+        for p in parts[:first]:
+            chain = p.turn(chain)[1]
+        sense = parts[first].input_sense * chain
+    senses, mirrors = [sense], []
+    for p in parts:
+        mirror, sense = p.turn(senses[-1])
+        mirrors.append(mirror)
+        senses.append(sense)
     return senses, mirrors

@@ -13,9 +13,11 @@ import math
 
 import numpy as np
 
+from ..model.kinds import register_stage_kind
 from ..model.planetary import PlanetaryStage
 from ..signals import stage_prefix
-from .shapes import MARKER, STEEL, WHEEL, Body, Cylinder, GearShape, Orbit, Prism
+from .drive import Drive, shaft_radius_m
+from .shapes import MARKER, SHAFT, STEEL, WHEEL, Body, Cylinder, GearShape, Orbit, Prism
 
 RING = (0.5, 0.52, 0.56, 1.0)
 CARRIER = (0.2, 0.45, 0.48, 1.0)
@@ -162,47 +164,80 @@ def stage_bodies(
     with when the result has no angle for it.
     """
     g = st.geometry
-    m, b = g.module_m, face_m
-    prefix = stage_prefix(stage)
     psis = [mirror * a for a in g.planet_angles_rad]
-    r_s, r_p, r_r, r_c = (
-        g.sun_pitch_radius_m,
-        g.planet_pitch_radius_m,
-        g.ring_pitch_radius_m,
-        g.carrier_radius_m,
-    )
     sun0, planet0, ring0 = first_teeth_rad(g.z_sun, g.z_planet, g.z_ring, psis)
+    sun_shaft = shaft_radius_m.get("sun", 0.0)
+    parts: dict[str, list] = {
+        "sun": [_gear(st, z_m, face_m, g.z_sun, sun0, STEEL, 0.98 * sun_shaft if sun_shaft else 0.0)],
+        "ring": [_gear(st, z_m, face_m, g.z_ring, ring0, RING, 0.0, internal=True)],
+        "carrier": _carrier_parts(st, z_m, face_m, psis, sun_shaft),
+    }
+    if st.fixed != "ring":  # a turning ring: a drum from its rim to its shaft
+        c_side, r_side = _sides(st)
+        z0, z1 = slot_z_m(z_m, face_m, r_side, 1 if r_side == c_side else 0)
+        parts["ring"].append(
+            Cylinder(z0, z1, g.ring_pitch_radius_m + 1.25 * g.module_m + RIM * g.module_m, RING)
+        )
+    for member, extra in shaft_parts.items():
+        parts[member] += list(extra)
+    prefix = stage_prefix(stage)
     speeds = st.speeds(1.0)
     w_in = speeds.of(st.input)
-
-    def gear(teeth, first, colour, bore, internal=False):
-        rim = r_r + 1.25 * m + RIM * m if internal else 0.0
-        return GearShape(
-            teeth,
-            m,
-            st.pressure_angle_deg,
-            b,
-            z_m,
-            bore,
-            first,
-            colour,
-            internal=internal,
-            rim_radius_m=rim,
-            outline="gearbody",
+    bodies = []
+    for mbr in ("sun", "ring", "carrier"):
+        if mbr == st.input:
+            fol, ratio = follows if follows else (None, 1.0)
+        else:
+            fol, ratio = prefix + st.input, speeds.of(mbr) / w_in
+        name = prefix + mbr
+        lateral = (f"{name}_x_m", f"{name}_y_m")
+        bodies.append(
+            Body(
+                name,
+                centre_xy_m,
+                mirror,
+                f"{name}_angle_rad",
+                tuple(parts[mbr]),
+                lateral,
+                fol,
+                ratio,
+                mirror=mirror,
+            )
         )
+    return bodies + _planet_bodies(st, prefix, centre_xy_m, z_m, face_m, mirror, psis, planet0)
 
+
+def _gear(st: PlanetaryStage, z_m: float, face_m: float, teeth, first, colour, bore, internal=False):
+    """A member's toothed outline in the stage's plane (the ring's with its rim)."""
+    g = st.geometry
+    m = g.module_m
+    rim = g.ring_pitch_radius_m + 1.25 * m + RIM * m if internal else 0.0
+    return GearShape(
+        teeth,
+        m,
+        st.pressure_angle_deg,
+        face_m,
+        z_m,
+        bore,
+        first,
+        colour,
+        internal=internal,
+        rim_radius_m=rim,
+        outline="gearbody",
+    )
+
+
+def _carrier_parts(st: PlanetaryStage, z_m: float, face_m: float, psis, sun_shaft: float) -> list:
+    """The carrier: a plate on its side with a pin through every planet (its bore lets the sun's shaft
+    through when that shaft leaves on the plate's side)."""
+    g, b = st.geometry, face_m
+    r_p, r_c = g.planet_pitch_radius_m, g.carrier_radius_m
     side = {st.input: -1, st.output: 1}  # -1: front (motor side), +1: back
-    c_side, r_side = _sides(st)
-    sun_shaft = shaft_radius_m.get("sun", 0.0)
+    c_side, _ = _sides(st)
     pin_r = 0.3 * r_p
-    parts: dict[str, list] = {
-        "sun": [gear(g.z_sun, sun0, STEEL, 0.98 * sun_shaft if sun_shaft else 0.0)],
-        "ring": [gear(g.z_ring, ring0, RING, 0.0, internal=True)],
-    }
-    # carrier: a plate on its side with a pin through every planet, and a marker stripe
     z0, z1 = slot_z_m(z_m, b, c_side, 0)
     bore = 1.3 * sun_shaft if side.get("sun") == c_side else 0.0
-    plate = carrier_outline(r_c, psis, 0.55 * r_p, max(0.5 * r_s, 2 * bore))
+    plate = carrier_outline(r_c, psis, 0.55 * r_p, max(0.5 * g.sun_pitch_radius_m, 2 * bore))
     z_far = z_m - c_side * 0.55 * b  # the pins stand just proud of the planets' far face
     z_plate = z0 if c_side > 0 else z1
     pins = [
@@ -211,42 +246,26 @@ def stage_bodies(
         )
         for a in psis
     ]
-    parts["carrier"] = [Prism(tuple(map(tuple, plate)), z0, z1, CARRIER, hole_radius_m=bore), *pins]
-    if st.fixed != "ring":  # a turning ring: a drum from its rim to its shaft
-        z0, z1 = slot_z_m(z_m, b, r_side, 1 if r_side == c_side else 0)
-        parts["ring"].append(Cylinder(z0, z1, r_r + 1.25 * m + RIM * m, RING))
-    for member, extra in shaft_parts.items():
-        parts[member] += list(extra)
+    return [Prism(tuple(map(tuple, plate)), z0, z1, CARRIER, hole_radius_m=bore), *pins]
 
-    bodies = []
-    names = {mbr: prefix + mbr for mbr in ("sun", "ring", "carrier")}
-    for mbr in ("sun", "ring", "carrier"):
-        if mbr == st.input:
-            fol, ratio = follows if follows else (None, 1.0)
-        else:
-            fol, ratio = names[st.input], speeds.of(mbr) / w_in
-        bodies.append(
-            Body(
-                names[mbr],
-                centre_xy_m,
-                mirror,
-                f"{names[mbr]}_angle_rad",
-                tuple(parts[mbr]),
-                (f"{names[mbr]}_x_m", f"{names[mbr]}_y_m"),
-                fol,
-                ratio,
-                mirror=mirror,
-            )
-        )
+
+def _planet_bodies(st: PlanetaryStage, prefix, centre_xy_m, z_m, face_m, mirror, psis, planet0) -> list[Body]:
+    """planet_1..N: each a gear with a marker, riding on the carrier at its angle."""
+    g, b = st.geometry, face_m
+    r_p, r_c = g.planet_pitch_radius_m, g.carrier_radius_m
+    speeds = st.speeds(1.0)
+    w_in = speeds.of(st.input)
+    pin_r = 0.3 * r_p
     marker_r = 0.08 * r_p
+    bodies = []
     for n, psi in enumerate(psis):
         name = f"{prefix}planet_{n + 1}"
         mark = Cylinder(
             z_m - 0.5 * b - 0.004 * b, z_m - 0.5 * b + 0.05 * b, marker_r, MARKER, x_m=0.6 * r_p, y_m=0.0
         )
-        shape = gear(g.z_planet, planet0[n], WHEEL, 1.02 * pin_r)
+        shape = _gear(st, z_m, face_m, g.z_planet, planet0[n], WHEEL, 1.02 * pin_r)
         axis = (centre_xy_m[0] + r_c * math.cos(psi), centre_xy_m[1] + r_c * math.sin(psi))
-        orbit = Orbit(names["carrier"], centre_xy_m, r_c, psi, (f"{name}_centre_x_m", f"{name}_centre_y_m"))
+        orbit = Orbit(prefix + "carrier", centre_xy_m, r_c, psi, (f"{name}_centre_x_m", f"{name}_centre_y_m"))
         bodies.append(
             Body(
                 name,
@@ -255,10 +274,80 @@ def stage_bodies(
                 f"{name}_angle_rad",
                 (shape, mark),
                 None,
-                names[st.input],
+                prefix + st.input,
                 speeds.planet_rad_s / w_in,
                 mirror=mirror,
                 orbit=orbit,
             )
         )
     return bodies
+
+
+class PlanetaryParts:
+    """A planetary stage's part of the 3D picture (the protocol of ``StageKind.render_parts``): coaxial,
+    its members drawn in its modelled senses (mirrored when the chain before it turns the other way)."""
+
+    fixes_sense = True  # the first planetary stage's input turns in its modelled sense
+
+    def __init__(self, scenario, k: int):
+        st = self.st = scenario.stages[k]
+        self.k = k
+        self.module_m = st.module_mm * 1e-3
+        self.width_m = 10 * self.module_m
+        # its axial room includes its carrier plate (and a turning ring's drum)
+        self.face_m = 2 * side_depth_m(st, self.width_m)
+        p = stage_prefix(k)
+        self.ends = (p + st.input, st.input_sense, p + st.output, st.output_sense)
+        self.mesh_pair = (p + "sun", p + "planet_1")  # the mesh camera follows the sun-planet 1 mesh
+        self.input_sense = st.input_sense
+
+    def turn(self, sense: int) -> tuple[int, int]:
+        """(mirror, output sense): mirrored when its input turns against its modelled sense."""
+        mirror = sense * self.st.input_sense
+        return mirror, mirror * self.st.output_sense
+
+    def output_axis(self, xy: tuple[float, float]) -> tuple[float, float]:
+        """Coaxial: the output shaft continues the input's axis."""
+        return xy
+
+    def shaft_cap_m(self, end: int) -> float:
+        """Largest drawn radius of the input (end 0) or output (end 1) shaft: 0.8 of the sun's root
+        radius on the sun, none on the ring or the carrier."""
+        st, m = self.st, self.module_m
+        member = (st.input, st.output)[end]
+        return 0.8 * (0.5 * m * st.sun.teeth - 1.25 * m) if member == "sun" else math.inf
+
+    def bodies(self, drive: Drive) -> list[Body]:
+        """Sun, ring, carrier and planets, the input shaft from the front (the coupling or the middle
+        between stages) and the output shaft to the back."""
+        st, k, b = self.st, self.k, self.width_m
+        radius = {
+            st.input: min(shaft_radius_m(drive.torques[k]), self.shaft_cap_m(0)),
+            st.output: min(shaft_radius_m(drive.torques[k + 1]), self.shaft_cap_m(1)),
+        }
+        z_in, z_out = (attach_z_m(st, m, drive.z_stage[k], b) for m in (st.input, st.output))
+        r_i, r_o = radius[st.input], radius[st.output]
+        if k == 0:
+            shaft_in = (Cylinder(drive.z_cpl_in, z_in, r_i, SHAFT), *drive.input_hub())
+        else:
+            shaft_in = (Cylinder(drive.between_m(k - 1), z_in, r_i, SHAFT),)
+        if k == drive.last:
+            z_cpl_out = drive.output_coupling_z_m(r_o)
+            shaft_out = (Cylinder(z_out, z_cpl_out, r_o, SHAFT), *drive.output_hub(r_o))
+        else:
+            shaft_out = (Cylinder(z_out, drive.between_m(k), r_o, SHAFT),)
+        follows = None if k == 0 else (drive.ends[k - 1][2], float(st.input_sense * drive.ends[k - 1][3]))
+        shafts = {st.input: shaft_in, st.output: shaft_out}
+        mirror = drive.mirrors[k]
+        bodies = stage_bodies(st, k, drive.axes[k], drive.z_stage[k], b, mirror, shafts, radius, follows)
+        drive.bearings.coaxial(k, r_i, r_o)
+        return bodies
+
+    @staticmethod
+    def teeth(table: dict) -> tuple:
+        """The teeth a saved stage table states: ('planetary', sun, planet, ring, planets)."""
+        z = [table.get(m, {}).get("teeth") for m in ("sun", "planet", "ring")]
+        return ("planetary", *z, table.get("planets"))
+
+
+register_stage_kind("planetary", render_parts=PlanetaryParts)
