@@ -16,6 +16,7 @@ import numba
 import numpy as np
 
 from ..assembly import Inertia
+from ..errors import SimulationError
 from ..physics import load_torque_at, motor_torque_at
 from ..physics.lateral import lateral_mesh_forces
 from ..physics.mesh import torsional_mesh_forces
@@ -71,9 +72,10 @@ def bearing_user_function(law, free_directions: tuple[int, ...]):
     return bearing_force
 
 
-class StallError(RuntimeError):
+class StallError(SimulationError):
     """Raised from inside a user function when the run stalls or diverges (Exudyn passes it on as its own
-    error; the watchdog's ``failure`` tells the caller what happened)."""
+    error; the watchdog's ``failure`` tells the caller what happened, in the :class:`SimulationError`
+    that :func:`gearbody.simulate` raises). A :class:`SimulationError` itself, should it escape."""
 
 
 CHECK_CALLS = 2_000  # force evaluations between divergence checks and progress updates (~250 attempts)
