@@ -12,6 +12,7 @@ from the share of each coordinate in the mode's kinetic energy (M_ii x_i^2). The
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import exudyn as exu
 import numpy as np
@@ -26,7 +27,7 @@ from ..assembly import (
     torsional_layout,
 )
 from ..assembly.compound import compound_layout, has_bearing_laws, stage_static_displacements
-from ..model import Scenario
+from ..model import Scenario, load_scenario
 from ..physics import mean_stiffness_N_per_m
 from .build import build_torsional
 from .compound import build_compound
@@ -83,8 +84,16 @@ def natural_frequencies(
     )
 
 
-def scene_modes(scenario: Scenario) -> ModeSet:
-    """Modes of a scene at its mean mesh stiffness (healthy teeth)."""
+def scene_modes(scenario: Scenario | str | Path) -> ModeSet:
+    """Natural frequencies and mode shapes of a drive, linearised at its mean mesh stiffness (healthy
+    teeth, no backlash; nonlinear bearings at their tangent under the rated mesh forces): a
+    :class:`~gearbody.analysis.modal.ModeSet`, each mode labelled by its dominant motion.
+
+    ``scenario``: a :class:`~gearbody.model.Scenario`, or a scene name or TOML path. This is
+    :func:`gearbody.modes`, and what ``gearbody modes SCENE`` prints.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
     if scenario.meta.topology == "muller":
         k_mean = mean_stiffness_N_per_m(mesh_parameters_from_scenario(scenario))
         SC = exu.SystemContainer()
