@@ -40,6 +40,11 @@ class PlanetaryTeeth(NamedTuple):
 
 @dataclass
 class Result:
+    """A run: named time signals on the output grid ``time_s`` (``result["mesh_force_N"]``; units in the
+    names) and ``meta`` (the resolved scenario, versions, seed, solver statistics, per-stage data), with
+    the analyses of a run as methods (``kd``, ``fold_kd``, ``spectrum``, ``features``, ``summary``);
+    ``save_npz`` writes it, :meth:`load_npz` reads it back."""
+
     time_s: np.ndarray
     signals: dict[str, np.ndarray]
     meta: dict[str, Any] = field(default_factory=dict)
