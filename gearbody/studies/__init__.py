@@ -28,7 +28,9 @@ only its own case, and the pool is restarted. At the end ``OUT/summary.csv``
 
 Global sensitivity analysis (:func:`sensitivity` of a scene, :func:`analyse_model` of any model function;
 Morris, Sobol) and calibration of a scene's keys to measured features (:func:`calibrate_scene` with
-:class:`Parameter` and :class:`Target`) run on the same executors: docs/calibration.md.
+:class:`Parameter` and :class:`Target`) run on the same executors: docs/calibration.md. Here
+``sensitivity`` is that function, which hides its module of the same name (import the module with
+``importlib.import_module("gearbody.studies.sensitivity")``).
 
 Public: the names of ``__all__``, importable from here (``from gearbody.studies import ...``).
 """
