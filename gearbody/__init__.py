@@ -13,6 +13,7 @@ the namespaces are imported when first used.
 """
 
 import importlib
+from typing import TYPE_CHECKING
 
 from .errors import (
     CalibrationFailed,
@@ -43,6 +44,11 @@ from .model import (
 from .physics.bearings import register_bearing
 from .result import Result
 from .version import __version__
+
+if TYPE_CHECKING:  # what __getattr__ gives, for type checkers and editors
+    from . import analysis, render, studies
+    from .engine import scene_modes as modes
+    from .engine import simulate
 
 _LAZY = {
     "simulate": ("gearbody.engine", "simulate"),
