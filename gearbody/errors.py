@@ -1,8 +1,10 @@
 """One error hierarchy for gearbody: every failure a user can meet is a :class:`GearbodyError`, and the
 command line maps its type to an exit code (never its message text).
 
-Physics (``gearbody.physics``) sits below this module and raises its own
-:class:`gearbody.physics.exceptions.PhysicsError`; the model wraps it into a :class:`ScenarioError`.
+This module imports nothing from gearbody, so every layer may use it (physics included: its
+:class:`~gearbody.physics.exceptions.GearGeometryError` is an :class:`InputError`, which the model wraps
+into a :class:`ScenarioError` naming the scenario key). ``tests/test_errors_hierarchy.py`` checks that
+every exception class defined in gearbody is a :class:`GearbodyError`.
 """
 
 from __future__ import annotations

@@ -40,6 +40,11 @@ class PlanetaryTeeth(NamedTuple):
 
 @dataclass
 class Result:
+    """A run: named time signals on the output grid ``time_s`` (``result["mesh_force_N"]``; units in the
+    names) and ``meta`` (the resolved scenario, versions, seed, solver statistics, per-stage data), with
+    the analyses of a run as methods (``kd``, ``fold_kd``, ``spectrum``, ``features``, ``summary``);
+    ``save_npz`` writes it, :meth:`load_npz` reads it back."""
+
     time_s: np.ndarray
     signals: dict[str, np.ndarray]
     meta: dict[str, Any] = field(default_factory=dict)
@@ -220,7 +225,7 @@ class Result:
         name = signal or self.vibration_signal_name
         ring = [k for k in self.planetary_stages if name == stage_signal("ring_sensor_N", k)]
         if ring:  # a planetary stage's ring sensor: the spectrum of its run plot and report
-            from .plotting.planetary import ring_sensor_spectrum
+            from .analysis.ring_sensor import ring_sensor_spectrum
 
             rs = ring_sensor_spectrum(self, ring[0])
             peaks = rs.peaks(min_prominence_db=min_prominence_db, max_peaks=max_peaks)
@@ -268,7 +273,7 @@ class Result:
 
         from .analysis import GearMesh, KinematicSources, Shaft, kinematic_lines
         from .analysis.planetary_lines import planetary_lines
-        from .plotting.planetary import planetary_sources
+        from .analysis.ring_sensor import planetary_sources
 
         lines: list = []
         shafts: list = []

@@ -173,7 +173,7 @@ def test_cli_refuses_bad_stage_and_load(capsys):
 def test_report_is_engine_free(tmp_path):
     code = (
         "import sys; from gearbody.model import load_scenario; "
-        "from gearbody.plotting.mesh import plot_stage; "
+        "from gearbody.reports.mesh.figure import plot_stage; "
         f"s = load_scenario('one-stage'); plot_stage(s, 0, {str(tmp_path / 'x.png')!r}); "
         "assert 'exudyn' not in sys.modules, 'exudyn imported'"
     )

@@ -1,4 +1,4 @@
-"""The ring-sensor spectrum of a simulated planetary run (gearbody.plotting.planetary.ring_sensor_spectrum):
+"""The ring-sensor spectrum of a simulated planetary run (gearbody.analysis.ring_sensor.ring_sensor_spectrum):
 a run long enough for its window resolves f_m and f_m +- f_c at the bins their labels name, the labels
 mark as cancelled exactly the lines McFadden and Smith's rule cancels, and a run too short says so."""
 
@@ -40,7 +40,7 @@ def test_a_short_run_says_what_it_resolves_and_how_long_a_run_would(tmp_path, ca
 
 @pytest.mark.slow
 def test_a_long_enough_run_resolves_the_mesh_line_and_its_carrier_sidebands(run):
-    from gearbody.plotting.planetary import ring_sensor_notes, ring_sensor_spectrum
+    from gearbody.analysis.ring_sensor import ring_sensor_notes, ring_sensor_spectrum
 
     ring = ring_sensor_spectrum(run, 0)
     n = ring.window.revolutions
@@ -60,7 +60,7 @@ def test_a_long_enough_run_resolves_the_mesh_line_and_its_carrier_sidebands(run)
 
 @pytest.mark.slow
 def test_the_labels_mark_exactly_the_lines_the_rule_cancels(run):
-    from gearbody.plotting.planetary import ring_sensor_spectrum
+    from gearbody.analysis.ring_sensor import ring_sensor_spectrum
 
     ring = ring_sensor_spectrum(run, 0)
     rule = {
@@ -92,7 +92,7 @@ def test_result_spectrum_of_the_ring_sensor_is_the_run_plot_s(tmp_path):
     """result.spectrum() of a drive whose first stage is planetary reads the ring sensor as its plot and
     report do: over the whole carrier revolutions, the cancelled lines marked."""
     from gearbody import load_scenario, simulate
-    from gearbody.plotting.planetary import ring_sensor_spectrum
+    from gearbody.analysis.ring_sensor import ring_sensor_spectrum
 
     res = simulate(load_scenario("planetary", ["operation.t_end_s=0.1", 'solver.accuracy="draft"']))
     ls, ring = res.spectrum(), ring_sensor_spectrum(res, 0)

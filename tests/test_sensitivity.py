@@ -3,6 +3,7 @@ known indices through the same sample -> job -> executor -> record -> analysis p
 resume, failed rows, input errors before anything runs, and on gearbody a key that cannot affect a
 feature gets an index of zero while one that matters gets a large one."""
 
+import importlib
 import json
 import math
 import struct
@@ -14,9 +15,11 @@ import pytest
 from gearbody.cli import main
 from gearbody.model import load_scenario
 from gearbody.studies import SweepSpecError
-from gearbody.studies import sensitivity as sens
 from gearbody.studies.executors import failure
 from gearbody.studies.sensitivity import MissingRowsError, analyse_model, ishigami, parse_key_range
+
+# the module (the attribute gearbody.studies.sensitivity is the public function of that name)
+sens = importlib.import_module("gearbody.studies.sensitivity")
 
 STEADY_OVERRIDES = (  # steady rated running from t = 0 (as conftest.STEADY_OVERRIDES)
     'operation.initial_state="steady"',

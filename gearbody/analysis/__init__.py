@@ -1,4 +1,10 @@
-"""Engine-free analysis of simulated or measured signals (plain numpy arrays in, dataclasses out)."""
+"""Engine-free analysis of simulated or measured signals (plain numpy arrays in, dataclasses out): spectra
+and their labelled peaks, kinematic lines, synchronous averages and condition indicators, K_d statistics,
+features (registered by name, evaluated on a run or a measurement), and the modal results: a drive's
+:class:`ModeSet` (from :func:`gearbody.modes`) and Lin & Parker's closed-form modes of a planetary stage.
+
+Public: the names of ``__all__``, importable from here (``from gearbody.analysis import ...``).
+"""
 
 from gearbody.analysis.dynamic_factor import (
     INSTABILITY_KD,
@@ -9,6 +15,18 @@ from gearbody.analysis.dynamic_factor import (
     periods_stats,
     separation_stats,
     unstable,
+)
+from gearbody.analysis.features import (
+    WINDOW_OPTIONS,
+    FeatureError,
+    FeatureKind,
+    FeatureSpec,
+    Record,
+    evaluate_features,
+    parse_feature,
+    register_feature,
+    resonance_speed,
+    unregister_feature,
 )
 from gearbody.analysis.indicators import (
     ConditionIndicators,
@@ -34,6 +52,7 @@ from gearbody.analysis.kinematics import (
     gear_train_lines,
     kinematic_lines,
 )
+from gearbody.analysis.modal import ModeSet, campbell_lines, resonance_speeds_rad_s
 from gearbody.analysis.peak_report import peaks_table, peaks_to_rows
 from gearbody.analysis.peaks import LabelledPeak, label_peaks
 from gearbody.analysis.planet_pass import (
@@ -56,6 +75,14 @@ from gearbody.analysis.spectrum import (
     sideband_lines,
 )
 from gearbody.analysis.tsa import AngleDomainSignal, SynchronousAverage, angle_resample, synchronous_average
+
+# Lin & Parker's modes of a planetary stage: engine-free like ModeSet (numpy's eigh on their matrices)
+from gearbody.physics.planetary_modal import (
+    PlanetaryModalParameters,
+    PlanetaryModes,
+    lin_parker_1999_parameters,
+    natural_modes,
+)
 
 __all__ = [
     "HannPassWindow",
@@ -113,4 +140,21 @@ __all__ = [
     "separation_stats",
     "sideband_lines",
     "unstable",
+    "WINDOW_OPTIONS",
+    "FeatureError",
+    "FeatureKind",
+    "FeatureSpec",
+    "Record",
+    "evaluate_features",
+    "parse_feature",
+    "register_feature",
+    "resonance_speed",
+    "unregister_feature",
+    "ModeSet",
+    "campbell_lines",
+    "resonance_speeds_rad_s",
+    "PlanetaryModalParameters",
+    "PlanetaryModes",
+    "lin_parker_1999_parameters",
+    "natural_modes",
 ]

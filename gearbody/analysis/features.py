@@ -89,6 +89,9 @@ INDICATORS = {
     "tsa_peak_to_peak": "peak_to_peak",
 }
 WINDOW_OPTIONS = ("period", "from_s", "to_s", "fraction")
+"""The options that choose a feature's window: an operating period (1-based), a span of time [s] or the
+final fraction of the record (default 0.25); a registered :class:`FeatureKind` lists them among its
+options to take a window."""
 MESH_OPTIONS = ("stage", "planet", "mesh")
 """Which mesh a K_d feature reads: the stage (1-based) and, on a planetary stage, the planet (1..N) and
 the mesh (``sun`` or ``ring``); without them every planet mesh of the stage."""

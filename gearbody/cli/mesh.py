@@ -1,5 +1,5 @@
 """``gearbody mesh SCENE``: the mesh report of each stage (:mod:`gearbody.reports.mesh`), printed, and
-its figure (:mod:`gearbody.plotting.mesh`)."""
+its figure (:mod:`gearbody.reports.mesh.figure`)."""
 
 from __future__ import annotations
 
@@ -99,8 +99,8 @@ def execute(args) -> int:
 
 def _report(args, scenario, stages, out) -> list:
     """Print each stage's report and write its plot in ``out`` (None: no plots); the plots written."""
-    from gearbody.plotting.mesh import plot_planetary_stage, plot_stage
     from gearbody.reports.mesh import damage_windows, static_transmission_error, stiffness_cycle, summary_text
+    from gearbody.reports.mesh.figure import plot_planetary_stage, plot_stage
     from gearbody.reports.mesh.planetary import (
         is_planetary,
         planetary_damage_windows,

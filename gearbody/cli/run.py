@@ -144,7 +144,7 @@ def execute(args) -> int:
             width = max(22, *(len(k) for k in keys))
             print(f"  {key:{width}s} {v:.4g}" if isinstance(v, float) else f"  {key:{width}s} {v}")
         if result.planetary_stages:  # a ring-sensor spectrum too short for the carrier sidebands
-            from gearbody.plotting.planetary import ring_sensor_notes
+            from gearbody.analysis.ring_sensor import ring_sensor_notes
 
             for note in ring_sensor_notes(result):
                 print(f"note: {note}")

@@ -12,6 +12,7 @@ from the share of each coordinate in the mode's kinetic energy (M_ii x_i^2). The
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import exudyn as exu
 import numpy as np
@@ -21,7 +22,7 @@ from ..assembly import TorsionalLayout, static_lateral_displacements_m, torsiona
 from ..assembly.compound import compound_layout, has_bearing_laws, stage_static_displacements
 from ..assembly.compound_system import compound_system
 from ..assembly.topology import muller_system, torsional_coordinates, torsional_system
-from ..model import Scenario
+from ..model import Scenario, load_scenario
 from ..physics import mean_stiffness_N_per_m
 from .build import build
 
@@ -76,8 +77,16 @@ def natural_frequencies(
     )
 
 
-def scene_modes(scenario: Scenario) -> ModeSet:
-    """Modes of a scene at its mean mesh stiffness (healthy teeth)."""
+def scene_modes(scenario: Scenario | str | Path) -> ModeSet:
+    """Natural frequencies and mode shapes of a drive, linearised at its mean mesh stiffness (healthy
+    teeth, no backlash; nonlinear bearings at their tangent under the rated mesh forces): a
+    :class:`~gearbody.analysis.modal.ModeSet`, each mode labelled by its dominant motion.
+
+    ``scenario``: a :class:`~gearbody.model.Scenario`, or a scene name or TOML path. This is
+    :func:`gearbody.modes`, and what ``gearbody modes SCENE`` prints.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
     if scenario.meta.topology == "muller":
         system = muller_system(scenario, modal=True)
         freqs, shapes = _eigen(build(system, sensors=False).mbs)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 
 import exudyn as exu
 import exudyn.solver
@@ -18,7 +19,7 @@ import numpy as np
 from ..assembly import check_resolved_modes, mesh_frequency_hz
 from ..assembly.layouts import drive_system
 from ..errors import GearbodyError, SimulationError
-from ..model import Scenario
+from ..model import Scenario, load_scenario
 from ..model.budget import memory_limit_bytes
 from ..model.kinds import register_stage_kind, stage_kind
 from ..model.scenario import SOLVER_METHODS
@@ -66,8 +67,17 @@ def build_scenario(scenario: Scenario) -> tuple[BuiltSystem, np.ndarray, np.ndar
     return build(layout, q0, v0), q0, v0
 
 
-def simulate(scenario: Scenario, *, progress: bool = False) -> Result:
-    """Simulate a scenario; raise :class:`SimulationError` on numerical failure."""
+def simulate(scenario: Scenario | str | Path, *, progress: bool = False) -> Result:
+    """Simulate a scenario on Exudyn and return its :class:`~gearbody.result.Result`.
+
+    ``scenario``: a :class:`~gearbody.model.Scenario`, or a scene name or TOML path
+    (:func:`~gearbody.model.load_scenario`). ``progress`` shows a progress bar on stderr. Raises
+    :class:`~gearbody.errors.InputError` for a scenario that cannot run (before anything is solved) and
+    :class:`SimulationError` on numerical failure (the message names the simulated time and a hint).
+    This is :func:`gearbody.simulate`.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
     wall0 = time.perf_counter()
     check_resolved_modes(scenario)  # a mode far above what the run resolves: refused (exit 2)
     built, _, _ = build_scenario(scenario)

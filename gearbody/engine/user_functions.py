@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from ..assembly.system import DriveItem, MullerItem
+from ..errors import SimulationError
 from ..physics import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
 from ..physics.compiled import compiled
 from ..physics.lateral import lateral_mesh_forces
@@ -60,9 +61,10 @@ def bearing_user_function(law, free_directions: tuple[int, ...]):
     return bearing_force
 
 
-class StallError(RuntimeError):
+class StallError(SimulationError):
     """Raised from inside a user function when the run stalls or diverges (Exudyn passes it on as its own
-    error; the watchdog's ``failure`` tells the caller what happened)."""
+    error; the watchdog's ``failure`` tells the caller what happened, in the :class:`SimulationError`
+    that :func:`gearbody.simulate` raises). A :class:`SimulationError` itself, should it escape."""
 
 
 CHECK_CALLS = 2_000  # force evaluations between divergence checks and progress updates (~250 attempts)

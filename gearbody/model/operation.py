@@ -29,6 +29,9 @@ class Profile(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Operation(Node):
+    """How a run is driven: its simulated time, the speed and load profiles (fractions of the synchronous
+    speed and the rated torque over time) and whether it starts from rest or steady running."""
+
     t_end_s: float = param(gt=0, doc="simulated time")
     initial_state: str = param("rest", choices=("rest", "steady"), doc="start from rest or steady running")
     speed_profile: Profile = param(

@@ -215,6 +215,11 @@ class Visual(Node):
 
 @dataclass(frozen=True, kw_only=True)
 class Scenario(Node):
+    """Everything a run is made of, as the TOML tables of a scene: ``meta``, ``design`` (motor, stages,
+    machine), ``operation``, ``condition``, ``solver`` and ``visual``. Immutable; validated when built
+    (a :class:`~gearbody.errors.ScenarioError` names the key); ``replace``/``with_stage`` make
+    changed copies. :func:`~gearbody.model.load_scenario` reads one."""
+
     meta: Meta
     design: Design
     operation: Operation

@@ -1,13 +1,18 @@
-"""Errors of the physics layer (engine-free, imports nothing from the rest of gearbody).
+"""Errors of the physics layer (engine-free: of the rest of gearbody it imports only :mod:`gearbody.errors`,
+which imports nothing).
 
-The model layer turns them into :class:`~gearbody.model.params.ScenarioError` where it calls physics
-(``gearbody.model.resolve``), with the same message, so users still see an input error (exit 2).
+Each is an :class:`~gearbody.errors.InputError` (so also a ``ValueError``): a user calling physics
+directly meets a gearbody error (exit 2). The model layer turns them into
+:class:`~gearbody.errors.ScenarioError` where it calls physics (``gearbody.model.resolve``), with the
+scenario key in front of the same message.
 """
 
 from __future__ import annotations
 
+from ..errors import InputError
 
-class GearGeometryError(ValueError):
+
+class GearGeometryError(InputError):
     """Impossible or unsound gear-pair geometry; the message names parameter, value and allowed range."""
 
 

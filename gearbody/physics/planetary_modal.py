@@ -33,6 +33,8 @@ import math
 
 import numpy as np
 
+from ..errors import InputError
+
 __all__ = [
     "MODE_KINDS",
     "ModeGroup",
@@ -52,7 +54,7 @@ ZERO_RTOL = 1e-10  # eigenvalues below this share of the largest are rigid-body 
 MOTION_TOL = 1e-8  # energy share below which a motion is taken as absent
 
 
-class PlanetaryModalError(ValueError):
+class PlanetaryModalError(InputError):
     """Unsound parameters of the planetary modal model (message: parameter, value, allowed range)."""
 
 

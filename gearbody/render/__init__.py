@@ -50,6 +50,9 @@ __all__ = [
 
 @dataclass
 class RenderOutput:
+    """What :func:`render` wrote: the frame PNGs, their times [s], the movie (or None), and the seconds
+    spent building the visual system and rendering."""
+
     frames: list[Path] = field(default_factory=list)
     times_s: np.ndarray | None = None
     movie: Path | None = None

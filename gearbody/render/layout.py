@@ -54,6 +54,9 @@ MESH_WINDOW_MODULES = 6.0
 
 @dataclass
 class Layout:
+    """A drive laid out in 3D from its scenario (:func:`build_layout`): the bodies with their parts,
+    the ground, the housing, and which signal turns the input shaft."""
+
     bodies: list[Body] = field(default_factory=list)
     ground: list = field(default_factory=list)
     machines: list = field(default_factory=list)  # motor and driven-machine frames (ground)

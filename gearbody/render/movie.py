@@ -17,6 +17,7 @@ from gearbody.folders import atomic_write
 from .poses import RenderError
 
 FORMATS = ("gif", "mp4", "none")
+"""The movie formats :func:`gearbody.render.render` writes (``mp4`` needs ffmpeg; ``none``: frames only)."""
 
 
 def write_png(image: np.ndarray, path: Path) -> Path:

@@ -24,6 +24,7 @@ VIEWS = {  # azimuth, elevation in degrees: the eye's direction from the drive's
     "side": (-90.0, 0.0),
     "top": (0.0, 89.0),
 }
+"""The camera directions by name (``RenderOptions.view``): azimuth and elevation in degrees."""
 
 
 FRAMES = ("drive", "gears", "mesh")

@@ -1,6 +1,6 @@
 """The report's content for a run with planetary stages (:func:`gearbody.reports.html.report_sections`
 dispatches here): the first planetary stage's ring-fixed sensor as the vibration signal, its spectrum
-over whole carrier revolutions relative to the ring (:func:`gearbody.plotting.planetary.ring_sensor_window`)
+over whole carrier revolutions relative to the ring (:func:`gearbody.analysis.ring_sensor.ring_sensor_window`)
 labelled with the stage's kinematic lines (carrier, planet pass, mesh harmonics and carrier sidebands,
 tooth fault frequencies; lines the phasing rule cancels marked "(cancelled)"), planet 1's sun-mesh K_d
 folded over the mesh period, and the synchronous average of the sensor over the window's carrier
@@ -18,8 +18,8 @@ from gearbody.analysis import (
     peaks_to_rows,
     synchronous_average,
 )
+from gearbody.analysis.ring_sensor import equally_spaced, ring_sensor_spectrum
 from gearbody.plotting.figure import png_base64
-from gearbody.plotting.planetary import equally_spaced, ring_sensor_spectrum
 from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure, tsa_figure
 from gearbody.result import Result
 

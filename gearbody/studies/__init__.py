@@ -25,8 +25,17 @@ spec, so rerunning the same study on the same folder resumes it. Ctrl-C raises
 only its own case, and the pool is restarted. At the end ``OUT/summary.csv``
 (:mod:`.table`) and ``OUT/<value>_vs_<key>.png`` are written. Spec parsing: :mod:`.parse` (``--vary``,
 ``--random``) and :mod:`.spec` (:class:`Study`, its cases). See docs/sweep.md.
+
+Global sensitivity analysis (:func:`sensitivity` of a scene, :func:`analyse_model` of any model function;
+Morris, Sobol) and calibration of a scene's keys to measured features (:func:`calibrate_scene` with
+:class:`Parameter` and :class:`Target`) run on the same executors: docs/calibration.md. Here
+``sensitivity`` is that function, which hides its module of the same name (import the module with
+``importlib.import_module("gearbody.studies.sensitivity")``).
+
+Public: the names of ``__all__``, importable from here (``from gearbody.studies import ...``).
 """
 
+from .calibration import CalibrationResult, Parameter, Target
 from .parse import (
     MAX_CASES,
     Axis,
@@ -38,6 +47,8 @@ from .parse import (
     parse_vary,
 )
 from .runner import StudyInterrupted, run_study
+from .scene_calibration import SceneCalibration, calibrate_scene
+from .sensitivity import SensitivityResult, analyse_model, ishigami, sensitivity
 from .spec import Case, Study
 from .speed import SpeedSweep, kd_speed_sweep, steady_overrides
 from .table import StudyResult
@@ -61,4 +72,13 @@ __all__ = [
     "run_case",
     "run_study",
     "steady_overrides",
+    "CalibrationResult",
+    "Parameter",
+    "SceneCalibration",
+    "SensitivityResult",
+    "Target",
+    "analyse_model",
+    "calibrate_scene",
+    "ishigami",
+    "sensitivity",
 ]

@@ -41,6 +41,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from gearbody.errors import GearbodyError
+
 from .parse import SweepSpecError
 
 __all__ = [
@@ -82,7 +84,7 @@ MAX_UNCHARGED_RESTARTS = 3
 """Pool restarts after a worker died between jobs (no job to charge) before the pending jobs fail."""
 
 
-class WorkerDied(RuntimeError):
+class WorkerDied(GearbodyError, RuntimeError):
     """A pool worker process died (killed by a signal, crashed, or exited) while running a job."""
 
 

@@ -5,7 +5,7 @@ Engine-free (no Exudyn): everything is evaluated with the mesh law of :mod:`gear
 scenario's packed parameters, so the curves are exactly what the solver uses. The data are plain
 dataclasses, arrays and rows (testable): :mod:`.stage` (a stage's parameters), :mod:`.table` (geometry
 and stiffness rows), :mod:`.curves` (k_z and static TE), :mod:`.text` (the printed summary);
-:func:`gearbody.plotting.mesh.plot_stage` draws them, one PNG per stage. docs/mesh.md describes the output.
+:func:`.figure.plot_stage` draws them, one PNG per stage. docs/mesh.md describes the output.
 
 Coordinates: ``u = phi_p z1 / (2 pi)`` counts mesh periods along the pinion angle phi_p; period
 ``n = floor(u)`` is the pair of pinion tooth ``n mod z1`` and wheel tooth ``n mod z2``, at mesh phase

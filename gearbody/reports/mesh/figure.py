@@ -2,8 +2,9 @@
 cycle (healthy), k_z around each damaged tooth and the static transmission error under load.
 
 Draws the data of :mod:`gearbody.reports.mesh` with :func:`gearbody.plotting.figure.new_figure` (no
-pyplot; matplotlib is imported only when a figure is drawn). Engine-free. docs/mesh.md describes the
-figure.
+pyplot; matplotlib is imported only when a figure is drawn). Engine-free. It lives with the data it
+draws, which come from the scenario: the plotting package below draws what it is given and imports
+nothing of the model. docs/mesh.md describes the figure.
 """
 
 from __future__ import annotations
@@ -13,7 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gearbody.reports.mesh.curves import (
+from gearbody.plotting.figure import PathLike, new_figure, save_figure
+
+from .curves import (
     DamageWindow,
     StaticTransmissionError,
     StiffnessCycle,
@@ -21,9 +24,7 @@ from gearbody.reports.mesh.curves import (
     stage_data,
     tooth_label,
 )
-from gearbody.reports.mesh.stage import stage_label
-
-from .figure import PathLike, new_figure, save_figure
+from .stage import stage_label
 
 __all__ = ["plot_planetary_stage", "plot_stage"]
 
@@ -162,7 +163,7 @@ def plot_planetary_stage(
     (healthy), k_z around each damaged tooth (at most MAX_WINDOWS_PLOTTED panels) and planet 1's static
     transmission error in each mesh over one revolution of the sun (ring) relative to its line of
     centres. Data not passed in is computed with :mod:`gearbody.reports.mesh.planetary`'s defaults."""
-    from gearbody.reports.mesh.planetary import (
+    from .planetary import (
         PLANET_MESHES,
         planetary_damage_windows,
         planetary_static_transmission_errors,
