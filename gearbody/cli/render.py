@@ -32,6 +32,7 @@ MAX_FRAMES = 2000  # gearbody.render.MAX_FRAMES (not imported here: the renderer
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    # size: a flat list of add_argument calls, one per option, read top to bottom like --help
     rd = sub.add_parser(
         "render",
         help="3D pictures and an animated GIF/MP4 of the drive moving as simulated (no display needed)",
