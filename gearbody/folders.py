@@ -18,24 +18,24 @@ outputs" are the files gearbody commands write (:data:`KINDS`), never a file of 
 - **Nothing half-written**: :func:`atomic_write` writes a temporary file in the same folder and renames
   it; an ``OSError`` on the way (a full disk) removes the temporary file and becomes
   :class:`~gearbody.errors.OutputError`, one line naming the file.
+
+The writing of files is :mod:`gearbody.atomic_files` and the lock :mod:`gearbody.folder_lock`; their
+names are also here.
 """
 
 from __future__ import annotations
 
-import contextlib
-import errno
-import fcntl
 import fnmatch
 import json
-import os
 import time
-import uuid
-from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from .errors import FolderInUse, InputError, OutputError
+from .atomic_files import atomic_write, output_error, write_text  # noqa: F401 (output_error: as before)
+from .errors import InputError, OutputError
+from .folder_lock import LOCK, FolderLock
 from .version import __version__
 
 __all__ = [
@@ -56,8 +56,6 @@ __all__ = [
 
 MANIFEST = ".gearbody.json"
 """What wrote a run, render or mesh folder: ``{"format", "command", "identity", "complete", ...}``."""
-LOCK = ".gearbody.lock"
-"""The lock file of a folder being written (``flock``; removed when the command ends)."""
 FORMAT = "gearbody-folder/1"
 TEMPORARY = ".*.tmp*"
 """Temporary files of :func:`atomic_write` (``.<stem>.<pid>.<random>.tmp<suffix>``)."""
@@ -118,43 +116,6 @@ KINDS: dict[str, Kind] = {  # studies first: their spec files mark them
     ),
 }
 STUDIES = ("sweep", "sensitivity", "calibrate")
-
-
-# -- writing files -------------------------------------------------------------------------------------
-def atomic_write(path: str | Path, write: Callable[[Path], Any]) -> Path:
-    """``write(tmp)`` to a temporary file in ``path``'s folder, then ``os.replace`` it onto ``path``:
-    a reader never sees a part, and a failed write leaves ``path`` as it was. An ``OSError`` (a full
-    disk, a lost permission) removes the temporary file and is raised as :class:`OutputError` naming
-    ``path`` (also an ``OSError``, with the original ``errno``)."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.stem}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp{path.suffix}")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            tmp.unlink(missing_ok=True)
-        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
-            raise output_error(path, exc) from None
-        raise
-    return path
-
-
-def write_text(path: str | Path, text: str) -> Path:
-    """``text`` to ``path`` atomically (:func:`atomic_write`), as UTF-8: a path quoted in it that is not
-    UTF-8 (its bytes kept as surrogates) gets U+FFFD in their place."""
-    text = text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
-    return atomic_write(path, lambda p: p.write_text(text))
-
-
-def output_error(path: str | Path, exc: OSError) -> OutputError:
-    """``cannot write PATH: <reason>`` as an :class:`OutputError` with ``exc``'s errno."""
-    reason = exc.strerror or str(exc) or type(exc).__name__
-    if exc.errno == errno.ENOSPC:
-        reason += " (the disk is full)"
-    error = OutputError(f"cannot write {path}: {reason}")
-    error.errno = exc.errno
-    return error
 
 
 # -- what a folder holds -------------------------------------------------------------------------------
@@ -283,97 +244,6 @@ def identity_differences(old: Mapping[str, Any], new: Mapping[str, Any], shown: 
     ]
     more = f"; and {len(keys) - shown} more" if len(keys) > shown else ""
     return "; ".join(parts) + more
-
-
-# -- the lock ------------------------------------------------------------------------------------------
-_HELD: dict[int, FolderLock] = {}  # fd -> lock held by this process (closed in forked children)
-
-
-def _forget_locks_in_child() -> None:
-    """In a forked child (a pool worker): close the inherited lock files without unlocking them (the
-    parent holds the lock; closing a copy of the descriptor leaves it held)."""
-    for fd in list(_HELD):
-        with contextlib.suppress(OSError):
-            os.close(fd)
-        _HELD[fd].fd = None
-    _HELD.clear()
-
-
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_forget_locks_in_child)
-
-
-@dataclass
-class FolderLock:
-    """``flock`` on ``folder/.gearbody.lock`` for one command; the file holds ``<pid> <command>``."""
-
-    folder: Path
-    command: str
-    fd: int | None = field(default=None, repr=False)
-
-    @property
-    def path(self) -> Path:
-        return self.folder / LOCK
-
-    def acquire(self, option: str = "--out") -> FolderLock:
-        """Take the lock, or :class:`FolderInUse` naming the command and pid that hold it."""
-        while True:
-            try:
-                fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
-            except OSError as exc:
-                raise output_error(self.path, exc) from None
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                holder = _holder(fd)
-                os.close(fd)
-                raise FolderInUse(
-                    f"{option} {self.folder}: another {holder} is writing in it; wait for it to end, or "
-                    f"choose another {option}"
-                ) from None
-            except OSError:  # a filesystem without flock: no lock, as before
-                os.close(fd)
-                return self
-            try:  # the file may have been removed by the holder it was taken from: lock the new one
-                same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
-            except FileNotFoundError:
-                same = False
-            if same:
-                break
-            os.close(fd)
-        self.fd = fd
-        _HELD[fd] = self
-        with contextlib.suppress(OSError):  # who holds it: for the message of a second command
-            os.ftruncate(fd, 0)
-            os.write(fd, f"{os.getpid()} {self.command}\n".encode())
-        return self
-
-    def release(self) -> None:
-        """Remove the lock file and release the lock (nothing if not held)."""
-        fd, self.fd = self.fd, None
-        if fd is None:
-            return
-        _HELD.pop(fd, None)
-        with contextlib.suppress(OSError):
-            if os.stat(self.path).st_ino == os.fstat(fd).st_ino:
-                os.unlink(self.path)
-        with contextlib.suppress(OSError):
-            fcntl.flock(fd, fcntl.LOCK_UN)
-        os.close(fd)
-
-    def __enter__(self) -> FolderLock:
-        return self.acquire() if self.fd is None else self
-
-    def __exit__(self, *exc) -> None:
-        self.release()
-
-
-def _holder(fd: int) -> str:
-    """``gearbody sweep (pid 1234)`` from a lock file's text."""
-    with contextlib.suppress(OSError, ValueError):
-        pid, command = os.pread(fd, 200, 0).decode().split()[:2]
-        return f"gearbody {command} (pid {int(pid)})"
-    return "gearbody command"
 
 
 # -- claiming a folder ---------------------------------------------------------------------------------

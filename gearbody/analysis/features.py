@@ -33,6 +33,10 @@ stage k > 1: ``stage_k_planet_<n>_...``, as a Result names them). The spectral f
 (``line_amplitude``) and the synchronous-average indicators read a parallel first stage's pinion (its
 angle and the pinion and wheel teeth); a record without those (a drive whose first stage is planetary)
 refuses them.
+
+The record and its window are in :mod:`.feature_record`, the feature functions on plain arrays in
+:mod:`.feature_functions`; this module holds the specs, the registry and gearbody's own features, and
+every public name of the three.
 """
 
 from __future__ import annotations
@@ -43,14 +47,24 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
 
-from gearbody.errors import InputError
-
-from ..signals import stage_signal
 from .dynamic_factor import separation_stats
+from .feature_functions import (
+    KD_STATISTICS,
+    kd_statistic,
+    line_amplitude,
+    line_frequency_hz,
+    natural_frequency_hz,
+    resonance_speed,
+)
+from .feature_record import (  # DEFAULT_FRACTION: this module's name before the split
+    DEFAULT_FRACTION,  # noqa: F401
+    FeatureError,
+    Record,
+    operating_periods_s,
+    stage_name,
+)
 from .indicators import condition_indicators_from_average, rms
-from .spectrum import amplitude_spectrum, peak_near
 from .tsa import synchronous_average
 
 __all__ = [
@@ -74,8 +88,6 @@ __all__ = [
     "unregister_feature",
 ]
 
-DEFAULT_FRACTION = 0.25
-KD_STATISTICS = ("max", "mean", "min", "std", "p50", "p95", "p99")
 INDICATORS = {
     "fm0": "fm0",
     "fm4": "fm4",
@@ -98,182 +110,6 @@ the mesh (``sun`` or ``ring``); without them every planet mesh of the stage."""
 PLANET_MESHES = ("sun", "ring")
 FEATURES: dict[str, tuple[str, ...]] = {}
 """Every feature name and the options it takes (filled by :func:`register_feature`, below)."""
-
-
-class FeatureError(InputError):
-    """A feature spec that names no feature, takes an option it does not have, or cannot be computed
-    from the record (a missing signal, an empty window, an unknown natural frequency, a stage of the
-    wrong kind); a ValueError, and a gearbody input error (exit code 2)."""
-
-
-# -- the feature functions on plain arrays ------------------------------------------------------------
-def kd_statistic(kd: ArrayLike, statistic: str = "max") -> float:
-    """``statistic`` of the K_d samples [-]: max, mean, min, std, p50, p95 or p99 (non-finite ignored)."""
-    values = np.asarray(kd, dtype=float).ravel()
-    values = values[np.isfinite(values)]
-    if values.size == 0:
-        raise FeatureError("kd: no finite samples in the window")
-    if statistic not in KD_STATISTICS:
-        raise FeatureError(f"kd statistic {statistic!r}: valid are {', '.join(KD_STATISTICS)}")
-    if statistic.startswith("p"):
-        return float(np.percentile(values, float(statistic[1:])))
-    return float(getattr(np, statistic)(values))
-
-
-def line_frequency_hz(
-    pinion_hz: float,
-    pinion_teeth: int,
-    wheel_teeth: int,
-    mesh: int = 1,
-    order: int = 0,
-    shaft: str = "pinion",
-) -> float:
-    """Frequency of the line ``mesh`` f_z + ``order`` f_shaft [Hz] of a gear pair whose pinion turns at
-    ``pinion_hz``: a mesh harmonic (order 0), a sideband (both non-zero) or a shaft order (mesh 0)."""
-    if shaft not in ("pinion", "wheel"):
-        raise FeatureError(f"shaft = {shaft!r}: valid are 'pinion', 'wheel'")
-    f_shaft = pinion_hz if shaft == "pinion" else pinion_hz * pinion_teeth / wheel_teeth
-    return mesh * pinion_hz * pinion_teeth + order * f_shaft
-
-
-def line_amplitude(
-    signal: ArrayLike, sample_rate_hz: float, frequency_hz: float, tolerance_bins: float = 2.0
-) -> float:
-    """Amplitude [signal unit] of the line at ``frequency_hz``: the largest bin of the Hann-windowed
-    amplitude spectrum (:func:`~gearbody.analysis.spectrum.amplitude_spectrum`) within
-    ``tolerance_bins`` bins of it (a sine of amplitude A on a bin reads A)."""
-    spec = amplitude_spectrum(signal, sample_rate_hz, window="hann")
-    if not 0.0 < frequency_hz < sample_rate_hz / 2:
-        raise FeatureError(
-            f"line at {frequency_hz:.6g} Hz: outside the spectrum (0, {sample_rate_hz / 2:.6g}) Hz"
-        )
-    return peak_near(spec, frequency_hz, tolerance_bins * spec.resolution_hz).amplitude
-
-
-def natural_frequency_hz(frequencies_hz: ArrayLike, mode: int = 1) -> float:
-    """The ``mode``-th (1-based) elastic natural frequency [Hz]: rigid-body modes (below 1e-5 of the
-    highest frequency) are skipped."""
-    f = np.sort(np.asarray(frequencies_hz, dtype=float).ravel())
-    if f.size == 0:
-        raise FeatureError("natural_frequency_hz: the record has no natural frequencies (compute the modes)")
-    elastic = f[f >= 1e-5 * f.max()]
-    if not 1 <= mode <= elastic.size:
-        raise FeatureError(f"natural_frequency_hz: mode = {mode}; the record has modes 1..{elastic.size}")
-    return float(elastic[mode - 1])
-
-
-def resonance_speed(speeds: ArrayLike, response: ArrayLike) -> tuple[float, bool]:
-    """The speed at which a speed sweep's ``response`` (e.g. max K_d per speed) peaks, refined by the
-    parabola through the largest sample and its two neighbours, in the unit of ``speeds``; and whether
-    the peak is inside the sweep (False: the largest response is at an end, the resonance may lie beyond)."""
-    s = np.asarray(speeds, dtype=float).ravel()
-    r = np.asarray(response, dtype=float).ravel()
-    if s.size != r.size or s.size < 3:
-        raise FeatureError(f"resonance_speed: need >= 3 speeds and as many responses, got {s.size}, {r.size}")
-    order = np.argsort(s)
-    s, r = s[order], r[order]
-    if np.any(np.diff(s) <= 0) or not np.all(np.isfinite(r)):
-        raise FeatureError("resonance_speed: speeds must be distinct and responses finite")
-    k = int(np.argmax(r))
-    if k in (0, s.size - 1):
-        return float(s[k]), False
-    a, b, _ = np.polyfit(s[k - 1 : k + 2], r[k - 1 : k + 2], 2)
-    vertex = -b / (2.0 * a) if a < 0 else s[k]
-    return float(min(max(vertex, s[k - 1]), s[k + 1])), True
-
-
-# -- records and specs ----------------------------------------------------------------------------------
-def operating_periods_s(t0_s: float, t1_s: float, profile_times_s: Sequence[float]) -> tuple[float, ...]:
-    """The operating periods of a run from ``t0_s`` to ``t1_s``: its start, every breakpoint of its speed
-    and load profiles (``profile_times_s``) inside the run, its end [s]."""
-    inner = {float(t) for t in profile_times_s if t0_s < float(t) < t1_s}
-    return (float(t0_s), *sorted(inner), float(t1_s))
-
-
-@dataclass(frozen=True)
-class Record:
-    """Signals on one uniform time grid and the facts of the drive that features need.
-
-    ``signals`` by name as a Result names them: ``kd``, ``mesh_force_N`` (stage k > 1: ``stage_k_kd``, ...),
-    a planetary stage's ``planet_<n>_sun_mesh_kd``, ``planet_<n>_ring_mesh_force_N``, ...,
-    ``pinion_angle_rad`` (a tachometer's angle suffices for spectra and synchronous averages), any
-    vibration signal. ``pinion_teeth``, ``wheel_teeth``: of a parallel first stage (None when the first
-    stage is planetary: the spectral and synchronous-average features then do not apply).
-    ``period_boundaries_s``: start of the first operating period, every boundary, end.
-    """
-
-    time_s: NDArray[np.float64]
-    signals: Mapping[str, NDArray[np.float64]]
-    pinion_teeth: int | None = None
-    wheel_teeth: int | None = None
-    period_boundaries_s: tuple[float, ...] = ()
-    natural_frequencies_hz: tuple[float, ...] = ()
-
-    def __post_init__(self) -> None:
-        t = np.asarray(self.time_s, dtype=float)
-        if t.ndim != 1 or t.size < 2 or not np.all(np.diff(t) > 0):
-            raise FeatureError("Record.time_s: need >= 2 strictly increasing sample times")
-        for name, values in self.signals.items():
-            if np.shape(values) != t.shape:
-                raise FeatureError(
-                    f"Record signal {name!r}: {np.shape(values)} samples, time_s has {t.shape}"
-                )
-        for name in ("pinion_teeth", "wheel_teeth"):
-            if getattr(self, name) is not None and int(getattr(self, name)) < 1:
-                raise FeatureError(f"Record.{name} = {getattr(self, name)}: must be >= 1")
-        if (self.pinion_teeth is None) != (self.wheel_teeth is None):
-            raise FeatureError(
-                "Record: give both pinion_teeth and wheel_teeth, or neither (no parallel stage 1)"
-            )
-
-    @property
-    def sample_rate_hz(self) -> float:
-        return float((self.time_s.size - 1) / (self.time_s[-1] - self.time_s[0]))
-
-    def signal(self, name: str) -> NDArray[np.float64]:
-        if name not in self.signals:
-            raise FeatureError(f"signal {name!r} not in the record (has: {', '.join(sorted(self.signals))})")
-        return np.asarray(self.signals[name], dtype=float)
-
-    def window(self, options: Mapping[str, float]) -> NDArray[np.bool_]:
-        """Mask of the analysed samples: operating ``period``, or ``from_s``..``to_s``, or the final
-        ``fraction`` (default 0.25)."""
-        t = self.time_s
-        if "period" in options:
-            edges = self.period_boundaries_s
-            n = int(options["period"])
-            if not 1 <= n <= len(edges) - 1:
-                raise FeatureError(f"period = {n}: the record has periods 1..{max(len(edges) - 1, 0)}")
-            last = n == len(edges) - 1
-            mask = (t >= edges[n - 1]) & ((t <= edges[n]) if last else (t < edges[n]))
-        elif "from_s" in options or "to_s" in options:
-            mask = (t >= options.get("from_s", -math.inf)) & (t <= options.get("to_s", math.inf))
-        else:
-            fraction = float(options.get("fraction", DEFAULT_FRACTION))
-            if not 0 < fraction <= 1:
-                raise FeatureError(f"fraction = {fraction}: must be > 0 and <= 1")
-            mask = t >= t[-1] - fraction * (t[-1] - t[0])
-        if np.count_nonzero(mask) < 2:
-            raise FeatureError(f"window {dict(options)}: fewer than 2 samples")
-        return mask
-
-    def planets(self, stage: int = 1) -> tuple[int, ...]:
-        """Planet numbers of stage ``stage`` (1-based) whose mesh K_d the record holds; () for a parallel
-        stage."""
-        prefix = _stage_name("", stage)
-        found = set()
-        for name in self.signals:
-            if name.startswith(prefix + "planet_") and name.endswith("_sun_mesh_kd"):
-                number = name[len(prefix + "planet_") : -len("_sun_mesh_kd")]
-                if number.isdigit():
-                    found.add(int(number))
-        return tuple(sorted(found))
-
-    def pinion_hz(self, mask: NDArray[np.bool_], stage: int = 1) -> float:
-        """Mean pinion rotation frequency [Hz] over the window, from the pinion angle."""
-        angle = self.signal(_stage_name("pinion_angle_rad", stage))[mask]
-        t = self.time_s[mask]
-        return float((angle[-1] - angle[0]) / (t[-1] - t[0]) / (2.0 * math.pi))
 
 
 @dataclass(frozen=True)
@@ -333,12 +169,6 @@ def _option_value(text: str, key: str, value: str, name: str = "") -> float | st
     return number
 
 
-def _stage_name(name: str, stage: int) -> str:
-    if stage < 1:
-        raise FeatureError(f"stage = {stage}: stages count from 1")
-    return stage_signal(name, stage - 1)
-
-
 def _mesh_signals(spec: FeatureSpec, record: Record, quantity: str) -> tuple[str, ...]:
     """The ``quantity`` (``kd`` or ``force_N``) signals of the meshes ``spec`` names: a parallel stage's
     one mesh, or a planetary stage's planet meshes (all, or ``planet`` and/or ``mesh``)."""
@@ -349,9 +179,9 @@ def _mesh_signals(spec: FeatureSpec, record: Record, quantity: str) -> tuple[str
         if "planet" in o or "mesh" in o:
             raise FeatureError(
                 f"feature {spec}: stage {stage} is no planetary stage (the record has no "
-                f"{_stage_name('planet_1_sun_mesh_kd', stage)!r}); planet and mesh apply to planetary stages"
+                f"{stage_name('planet_1_sun_mesh_kd', stage)!r}); planet and mesh apply to planetary stages"
             )
-        return (_stage_name("kd" if quantity == "kd" else "mesh_force_N", stage),)
+        return (stage_name("kd" if quantity == "kd" else "mesh_force_N", stage),)
     chosen = planets
     if "planet" in o:
         if int(o["planet"]) not in planets:
@@ -365,7 +195,7 @@ def _mesh_signals(spec: FeatureSpec, record: Record, quantity: str) -> tuple[str
         if o["mesh"] not in PLANET_MESHES:
             raise FeatureError(f"feature {spec}: mesh = {o['mesh']!r}; valid are 'sun', 'ring'")
         meshes = (str(o["mesh"]),)
-    return tuple(_stage_name(f"planet_{n}_{m}_mesh_{quantity}", stage) for n in chosen for m in meshes)
+    return tuple(stage_name(f"planet_{n}_{m}_mesh_{quantity}", stage) for n in chosen for m in meshes)
 
 
 def _parallel_first_stage(spec: FeatureSpec, record: Record) -> tuple[int, int]:

@@ -101,6 +101,21 @@ def label_peaks(
         if not isinstance(line, KinematicLine):
             raise ValueError(f"lines[{i}] must be a KinematicLine, got {type(line).__name__}")
 
+    index, prominence_db, keep = _prominent_peaks(f, a, min_prominence_db, max_peaks, floor_bins, f_max_hz)
+    return _labelled(f, a, index, prominence_db, keep, lines, tolerance_hz)
+
+
+def _prominent_peaks(
+    f: np.ndarray,
+    a: np.ndarray,
+    min_prominence_db: float,
+    max_peaks: int | None,
+    floor_bins: int,
+    f_max_hz: float | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(peak bins, their prominence over the local floor [dB], the positions kept)``: the local maxima
+    ``min_prominence_db`` over the median of +- ``floor_bins``, from bin 2 up to ``f_max_hz``; the
+    ``max_peaks`` most prominent kept, in order of frequency."""
     from scipy.ndimage import median_filter  # scipy.signal/ndimage: ~0.5 s to import, on use only
     from scipy.signal import find_peaks
 
@@ -113,7 +128,19 @@ def label_peaks(
         prominence_db = 20.0 * np.log10(a[index] / floor[index])
     keep = np.argsort(-prominence_db, kind="stable")[:max_peaks]
     keep = np.sort(keep)
+    return index, prominence_db, keep
 
+
+def _labelled(
+    f: np.ndarray,
+    a: np.ndarray,
+    index: np.ndarray,
+    prominence_db: np.ndarray,
+    keep: np.ndarray,
+    lines: list[KinematicLine],
+    tolerance_hz: float,
+) -> list[LabelledPeak]:
+    """The kept peaks, each with the labels of the lines within ``tolerance_hz``, nearest first."""
     line_hz = np.array([line.frequency_hz for line in lines], dtype=float)
     within_hz = tolerance_hz * (1.0 + 1e-9)
     out = []

@@ -23,6 +23,7 @@ from .common import (
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    # size: a flat list of add_argument calls, one per option, read top to bottom like --help
     ca = sub.add_parser(
         "calibrate",
         help="fit scenario keys within bounds to target features (model updating), resumable",

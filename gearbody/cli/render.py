@@ -32,6 +32,7 @@ MAX_FRAMES = 2000  # gearbody.render.MAX_FRAMES (not imported here: the renderer
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    # size: a flat list of add_argument calls, one per option, read top to bottom like --help
     rd = sub.add_parser(
         "render",
         help="3D pictures and an animated GIF/MP4 of the drive moving as simulated (no display needed)",
@@ -142,19 +143,16 @@ def _sha256(path: Path) -> str:
 
 
 def execute(args) -> int:
-    try:
-        background = tuple(float(v) for v in args.background.split(","))
-        if len(background) != 3 or not all(0 <= v <= 1 for v in background):
-            raise ValueError
-    except ValueError:
+    """Run ``gearbody render`` with the parsed ``args``; the exit code."""
+    background = _background(args.background)
+    if background is None:
         return usage_error("render", f"--background = {args.background!r}: give R,G,B in [0, 1]")
     out_dir = args.out or default_out(args.scene, "render")
     if not args.interactive:
         check_out(out_dir)
-    from gearbody.folders import atomic_write, claim, read_manifest
-    from gearbody.render import RenderError, RenderOptions, check_frames, check_render, render, view
+    from gearbody.folders import atomic_write
+    from gearbody.render import RenderError, check_frames, render, view
     from gearbody.render.scene3d import has_display
-    from gearbody.result import Result
 
     if args.interactive and not has_display():  # before a scene is simulated for a viewer never shown
         return usage_error(
@@ -164,17 +162,7 @@ def execute(args) -> int:
         )
 
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
-    options = RenderOptions(
-        width_px=args.width,
-        height_px=args.height,
-        view=args.view,
-        azimuth_deg=args.azimuth,
-        elevation_deg=args.elevation,
-        zoom=args.zoom,
-        frame=args.frame,
-        housing=args.housing,
-        background=background,
-    )
+    options = _options(args, background)
     folder = None
     stack = contextlib.ExitStack()  # the claim on the output folder, released at the end
     try:
@@ -185,63 +173,14 @@ def execute(args) -> int:
             raise RenderError(
                 "--t-end applies only when SCENE is simulated first (not with --result or --kinematic)"
             )
-        if args.result is not None:
-            path = args.result / "result.npz" if args.result.is_dir() else args.result
-            if not path.is_file():
-                raise RenderError(
-                    f"--result = {args.result}: no result.npz there (write one with 'gearbody run')"
-                )
-            try:
-                result = Result.load_npz(path)
-            except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):  # not gearbody's npz
-                raise RenderError(
-                    f"--result = {args.result}: {path.name} is not a result written by 'gearbody run'"
-                ) from None
-            inside = not args.interactive and path.resolve().parent == out_dir.resolve()
-            # the same result file: the same motion; the result a render simulated into --out: its motion
-            motion = "simulated" if inside else f"result sha256 {_sha256(path)}"
-        else:
-            motion = "kinematic" if args.kinematic else "simulated"
+        result, path, inside, motion = _motion(args, out_dir)
         if not args.interactive and (args.result is not None or args.kinematic):
             # the motion is known: whatever render would refuse is refused before the folder is claimed
-            check_render(
-                scenario,
-                result if args.result is not None else None,
-                frames=24 if args.frames is None else args.frames,
-                start_s=args.start,
-                end_s=args.end,
-                options=options,
-                lateral_scale=args.lateral_scale,
-                movie=args.format,
-                fps=args.fps,
-            )
+            _check_known_motion(args, scenario, result, options)
         if not args.interactive:  # locked while it writes; the old outputs go just before the new ones
-            from gearbody.model import scenario_to_dict
-
-            identity = {"scenario": scenario_to_dict(scenario), "motion": motion}
-            recorded = read_manifest(out_dir) if args.result is not None and inside else None
-            if (
-                recorded
-                and recorded["command"] == "render"
-                and (recorded.get("identity") or {}).get("motion") == motion
-            ):
-                identity = recorded["identity"]  # its own simulated result, drawn again: the same run
-            folder = stack.enter_context(claim(out_dir, "render", identity, overwrite=args.overwrite))
-            if args.result is not None and inside and folder.mode != "same":
-                raise RenderError(
-                    f"--result = {args.result}: it is in --out {out_dir}, which holds another run "
-                    "(--overwrite would remove it); render into another --out"
-                )
+            folder = _claim(args, scenario, out_dir, motion, inside, stack)
         if args.result is None and not args.kinematic:
-            from gearbody.engine import simulate
-
-            check_wall_time(scenario, args)
-            if not args.quiet:
-                print(f"simulating {args.scene} ({scenario.operation.t_end_s:g} s) ...")
-            result = simulate(scenario, progress=not args.quiet)
-            warn_if_backwards(result)
-        elif args.kinematic:
-            result = None
+            result = _simulate(args, scenario)
         if folder is not None:  # the result read from --out stays (with its scenario.toml)
             folder.begin(keep=[path, path.with_name("scenario.toml")] if args.result is not None else [])
         if args.result is None and not args.kinematic and not args.interactive:
@@ -251,31 +190,18 @@ def execute(args) -> int:
             atomic_write(out_dir / "result.npz", result.save_npz)
             atomic_write(out_dir / "scenario.toml", lambda p: dump_scenario(scenario, p))
         if args.interactive:
-            view(
-                scenario,
-                result,
-                frames=400 if args.frames is None else max(args.frames, 2),
-                start_s=args.start,
-                end_s=args.end,
-                options=options,
-                lateral_scale=args.lateral_scale,
-                lateral_about_mean=not args.lateral_static,
-                fps=args.fps,
-            )
+            frames = 400 if args.frames is None else max(args.frames, 2)
+            view(scenario, result, frames=frames, **_motion_options(args, options))
             return EXIT_OK
         t0 = time.perf_counter()
+        frames = 24 if args.frames is None else args.frames
         out = render(
             scenario,
             result,
             out_dir=out_dir,
-            frames=24 if args.frames is None else args.frames,
-            start_s=args.start,
-            end_s=args.end,
-            options=options,
-            lateral_scale=args.lateral_scale,
-            lateral_about_mean=not args.lateral_static,
+            frames=frames,
+            **_motion_options(args, options),
             movie=args.format,
-            fps=args.fps,
             progress=not args.quiet,
         )
         folder.finish()
@@ -294,3 +220,119 @@ def execute(args) -> int:
             + f" in {time.perf_counter() - t0:.1f} s ({per:.2f} s per frame, scene build {out.build_s:.1f} s)"
         )
     return EXIT_OK
+
+
+def _background(text: str) -> tuple[float, ...] | None:
+    """``--background R,G,B`` as three numbers in [0, 1], or None."""
+    try:
+        background = tuple(float(v) for v in text.split(","))
+        if len(background) != 3 or not all(0 <= v <= 1 for v in background):
+            raise ValueError
+    except ValueError:
+        return None
+    return background
+
+
+def _options(args, background: tuple[float, ...]):
+    """The :class:`~gearbody.render.RenderOptions` of the command line."""
+    from gearbody.render import RenderOptions
+
+    return RenderOptions(
+        width_px=args.width,
+        height_px=args.height,
+        view=args.view,
+        azimuth_deg=args.azimuth,
+        elevation_deg=args.elevation,
+        zoom=args.zoom,
+        frame=args.frame,
+        housing=args.housing,
+        background=background,
+    )
+
+
+def _motion_options(args, options) -> dict:
+    """The options the viewer and the renderer share: the time span, the look, the lateral scale, fps."""
+    return {
+        "start_s": args.start,
+        "end_s": args.end,
+        "options": options,
+        "lateral_scale": args.lateral_scale,
+        "lateral_about_mean": not args.lateral_static,
+        "fps": args.fps,
+    }
+
+
+def _motion(args, out_dir: Path) -> tuple:
+    """``(result, its path, whether it is in --out, the motion's identity)``: the result of ``--result``
+    read (None, None, False otherwise), the motion ``kinematic``, ``simulated`` or the result file's hash."""
+    from gearbody.render import RenderError
+    from gearbody.result import Result
+
+    if args.result is None:
+        return None, None, False, "kinematic" if args.kinematic else "simulated"
+    path = args.result / "result.npz" if args.result.is_dir() else args.result
+    if not path.is_file():
+        raise RenderError(f"--result = {args.result}: no result.npz there (write one with 'gearbody run')")
+    try:
+        result = Result.load_npz(path)
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):  # not gearbody's npz
+        raise RenderError(
+            f"--result = {args.result}: {path.name} is not a result written by 'gearbody run'"
+        ) from None
+    inside = not args.interactive and path.resolve().parent == out_dir.resolve()
+    # the same result file: the same motion; the result a render simulated into --out: its motion
+    motion = "simulated" if inside else f"result sha256 {_sha256(path)}"
+    return result, path, inside, motion
+
+
+def _check_known_motion(args, scenario, result, options) -> None:
+    """Whatever the renderer would refuse of a motion known before the run (--result, --kinematic)."""
+    from gearbody.render import check_render
+
+    check_render(
+        scenario,
+        result if args.result is not None else None,
+        frames=24 if args.frames is None else args.frames,
+        start_s=args.start,
+        end_s=args.end,
+        options=options,
+        lateral_scale=args.lateral_scale,
+        movie=args.format,
+        fps=args.fps,
+    )
+
+
+def _claim(args, scenario, out_dir: Path, motion: str, inside: bool, stack: contextlib.ExitStack):
+    """The claim on ``out_dir`` (entered on ``stack``) for this render's identity: the scenario and the
+    motion, or the identity recorded there when it draws its own simulated result again."""
+    from gearbody.folders import claim, read_manifest
+    from gearbody.model import scenario_to_dict
+    from gearbody.render import RenderError
+
+    identity = {"scenario": scenario_to_dict(scenario), "motion": motion}
+    recorded = read_manifest(out_dir) if args.result is not None and inside else None
+    if (
+        recorded
+        and recorded["command"] == "render"
+        and (recorded.get("identity") or {}).get("motion") == motion
+    ):
+        identity = recorded["identity"]  # its own simulated result, drawn again: the same run
+    folder = stack.enter_context(claim(out_dir, "render", identity, overwrite=args.overwrite))
+    if args.result is not None and inside and folder.mode != "same":
+        raise RenderError(
+            f"--result = {args.result}: it is in --out {out_dir}, which holds another run "
+            "(--overwrite would remove it); render into another --out"
+        )
+    return folder
+
+
+def _simulate(args, scenario):
+    """The scene simulated (its wall time checked first), warned about if it ran backwards."""
+    from gearbody.engine import simulate
+
+    check_wall_time(scenario, args)
+    if not args.quiet:
+        print(f"simulating {args.scene} ({scenario.operation.t_end_s:g} s) ...")
+    result = simulate(scenario, progress=not args.quiet)
+    warn_if_backwards(result)
+    return result

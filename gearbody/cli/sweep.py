@@ -25,6 +25,7 @@ MAX_CASES = 10_000  # gearbody.studies.MAX_CASES (not imported here: heavy impor
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    # size: a flat list of add_argument calls, one per option, read top to bottom like --help
     sw = sub.add_parser(
         "sweep",
         help="parameter study: many runs with scenario keys varied (grid, Monte-Carlo, seeds), resumable",

@@ -106,6 +106,7 @@ def gear_pair_geometry(
     given (pinion, wheel) tip diameters override the computed ones (e.g. a drawing's rounded values).
     Raises :class:`GearGeometryError` for impossible or unsound pairs (module docstring, "Checks").
     """
+    # size: the ISO 21771 formula chain and its checks in order, read top to bottom (shared intermediates)
     _check_inputs(
         module_m,
         teeth_pinion,

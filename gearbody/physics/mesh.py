@@ -1,3 +1,4 @@
+# size: the compiled mesh law is one unit: every njit function reads the one packed I_* layout (docstring)
 """Gear mesh force law, eqs. (4)-(6) of the paper plus inter-tooth friction. Engine-free.
 
 One scalar law, :func:`mesh_contact`, compiled with numba; the solver calls it through
@@ -25,7 +26,7 @@ Across the tooth change the factor and the error are blended between the outgoin
 (each evaluated with its own phase, p + 1 or p - 1). Each ramp is antisymmetric about its centre, so the
 mean stiffness over a period is unchanged. docs/scenario.md, "Transition width".
 
-The module stays whole (~480 lines): every compiled function here reads the one packed parameter layout
+The module stays whole (~550 lines): every compiled function here reads the one packed parameter layout
 (the ``I_*`` offsets) and numba compiles them together; split, the layout would be written twice.
 """
 
@@ -107,21 +108,9 @@ def pack_mesh_parameters(
     head = np.zeros(I_HEADER)
     head[I_R1], head[I_R2], head[I_Z1], head[I_Z2] = r1_m, r2_m, z1, z2
     head[I_KIND] = PROFILE_TABLE if tp.size else PROFILE_CONTACT_RATIO
-    pairs: list[np.ndarray] = []
-    if pair_stiffness_N_per_m is not None:
-        kp = np.asarray(pair_stiffness_N_per_m, float)
-        if tp.size or kp.ndim != 1 or kp.size < 2:
-            raise ValueError("a pair stiffness table needs >= 2 points and no phase table")
-        head[I_KIND], head[I_PAIR_N] = PROFILE_PAIRS, kp.size
-        slots = {"pinion": np.zeros(z1), "wheel": np.zeros(z2)}
-        tables = []
-        for (gear, tooth), ratio in sorted((pair_ratios or {}).items()):
-            ratio = np.asarray(ratio, float)
-            if ratio.shape != kp.shape:
-                raise ValueError("pair ratio tables must have the pair table's points")
-            tables.append(ratio)
-            slots[gear][tooth] = len(tables)
-        pairs = [kp, slots["pinion"], slots["wheel"], *tables]
+    pairs = _pair_blocks(pair_stiffness_N_per_m, pair_ratios, tp.size, z1, z2)
+    if pairs:
+        head[I_KIND], head[I_PAIR_N] = PROFILE_PAIRS, pairs[0].size
     head[I_KSINGLE], head[I_KDOUBLE] = stiffness_single_N_per_m, stiffness_double_N_per_m
     head[I_HALF_DOUBLE] = 0.5 * (contact_ratio - 1.0)
     head[I_CZ], head[I_LU], head[I_MU], head[I_PITCH] = (
@@ -140,6 +129,31 @@ def pack_mesh_parameters(
     head[I_WIDTH] = transition_width
     head[I_V0] = friction_transition_speed_m_s
     return np.concatenate([head, e, f, g, tp, tk, pits_p.T.ravel(), pits_w.T.ravel(), *pairs])
+
+
+def _pair_blocks(
+    pair_stiffness_N_per_m: np.ndarray | None,
+    pair_ratios: dict[tuple[str, int], np.ndarray] | None,
+    table_points: int,
+    z1: int,
+    z2: int,
+) -> list[np.ndarray]:
+    """The "pairs" profile's blocks of the packed array: healthy pair table, ratio-table slot per pinion
+    tooth and per wheel tooth, the ratio tables; none without a pair table."""
+    if pair_stiffness_N_per_m is None:
+        return []
+    kp = np.asarray(pair_stiffness_N_per_m, float)
+    if table_points or kp.ndim != 1 or kp.size < 2:
+        raise ValueError("a pair stiffness table needs >= 2 points and no phase table")
+    slots = {"pinion": np.zeros(z1), "wheel": np.zeros(z2)}
+    tables = []
+    for (gear, tooth), ratio in sorted((pair_ratios or {}).items()):
+        ratio = np.asarray(ratio, float)
+        if ratio.shape != kp.shape:
+            raise ValueError("pair ratio tables must have the pair table's points")
+        tables.append(ratio)
+        slots[gear][tooth] = len(tables)
+    return [kp, slots["pinion"], slots["wheel"], *tables]
 
 
 @njit(cache=True)

@@ -30,13 +30,26 @@ import json
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from gearbody.errors import InputError
 from gearbody.folders import output_error, write_text
+
+from .calibration_result import (  # the constants: this module's names before the split
+    AT_BOUND_TOLERANCE,
+    IDENTIFIED_MIN_SINGULAR_VALUE,  # noqa: F401
+    NULL_COMPONENT,  # noqa: F401
+    NUMERICAL_RCOND,  # noqa: F401
+    CalibrationResult,
+    Uncertainty,
+    uncertainty,
+)
+
+# OPTIMIZER: this module's name before the split
+from .calibration_search import OPTIMIZER, global_search, least_squares_polish, step  # noqa: F401
 
 __all__ = [
     "CalibrationError",
@@ -49,24 +62,8 @@ __all__ = [
     "uncertainty",
 ]
 
-OPTIMIZER = "TwoPointsDE"
-"""nevergrad optimiser of the global search."""
-
 FAILED_RESIDUAL = 1e3
 """Residual given to every target of a failed evaluation (cost 5e5 per target: worse than any fit)."""
-
-IDENTIFIED_MIN_SINGULAR_VALUE = 1.0
-"""A direction of the normalised parameters whose Jacobian singular value is below this has a 1-sigma
-wider than the search box (1 in normalised coordinates): the targets do not identify it within the
-bounds. A parameter whose 1-sigma is wider than its own box is unidentified for the same reason."""
-
-NUMERICAL_RCOND = 1e-10
-"""Singular values below this fraction of the largest are zero (an exact combination of parameters that
-no target sees); every parameter with a component above :data:`NULL_COMPONENT` in such a direction is
-unidentified."""
-
-NULL_COMPONENT = 1e-6
-"""Largest component of a parameter in an exactly unidentified direction that is rounding, not a share."""
 
 UNCERTAINTY_STEP = 1e-2
 """Forward-difference step (normalised coordinates: 1 % of the search box) of the Jacobian the
@@ -74,10 +71,6 @@ uncertainty is computed from. Simulated features jitter under tiny parameter cha
 amplitude of one-stage by up to 9e-4 relative for a 1e-4 change of the mesh damping): divided by a
 step of 1e-3 that jitter outweighed the weakest parameter's true sensitivity and its sigma changed 30x
 between two fits at the same point; at 1e-2 it agrees with central differences of 1e-2 and 3e-2."""
-
-AT_BOUND_TOLERANCE = 1e-2
-"""A fitted parameter closer than this fraction of its search box (normalised coordinates) to a bound
-ends on it: flagged in the result and warned about."""
 
 
 class CalibrationError(InputError):
@@ -236,166 +229,6 @@ def _record(line: str) -> dict | None:
     return item if isinstance(item, dict) else None
 
 
-@dataclass(frozen=True)
-class Uncertainty:
-    """The linearised uncertainty of a fit, in normalised coordinates (1 = the width of the search box).
-
-    ``sigma_unit[j]``: 1-sigma of parameter j (``inf``: unidentified); ``correlation``: in [-1, 1], NaN in
-    the rows of unidentified parameters; ``singular_values`` (descending, one per parameter: zeros where
-    there are fewer targets) and ``directions`` (their unit vectors as columns) of the Jacobian."""
-
-    sigma_unit: np.ndarray
-    correlation: np.ndarray
-    singular_values: np.ndarray
-    directions: np.ndarray
-
-    @property
-    def identified(self) -> np.ndarray:
-        """Per parameter: is its 1-sigma finite and within its search box."""
-        return np.isfinite(self.sigma_unit) & (self.sigma_unit <= 1.0 / IDENTIFIED_MIN_SINGULAR_VALUE)
-
-    @property
-    def unidentified_directions(self) -> list[tuple[float, np.ndarray]]:
-        """(singular value, unit direction) of every direction whose 1-sigma is wider than the box; each
-        direction signed so that its first component above 1e-3 is positive."""
-        out = []
-        for s, v in zip(self.singular_values, self.directions.T, strict=True):
-            if s < IDENTIFIED_MIN_SINGULAR_VALUE:
-                out.append((float(s), v * np.sign(v[np.flatnonzero(np.abs(v) > 1e-3)[0]])))
-        return out
-
-
-def uncertainty(jacobian_unit: np.ndarray) -> Uncertainty:
-    """The uncertainty from the Jacobian ``d residual / d u`` (targets x parameters) in normalised
-    coordinates, by its SVD: ``cov = V diag(1 / s^2) V^T`` over the directions with a non-zero singular
-    value; a parameter touching a zero one, or whose 1-sigma exceeds its box, is unidentified."""
-    J = np.atleast_2d(np.asarray(jacobian_unit, float))
-    n = J.shape[1]
-    if not np.all(np.isfinite(J)):
-        nan = np.full((n, n), math.nan)
-        return Uncertainty(np.full(n, math.inf), nan, np.zeros(n), np.eye(n))
-    _, s, vt = np.linalg.svd(J, full_matrices=True)
-    singular = np.zeros(n)
-    singular[: s.size] = s
-    V = vt.T
-    zero = singular <= NUMERICAL_RCOND * singular[0] if singular[0] > 0 else np.ones(n, bool)
-    inverse_square = np.zeros(n)
-    inverse_square[~zero] = 1.0 / singular[~zero] ** 2
-    cov = (V * inverse_square) @ V.T
-    variance = np.clip(np.diag(cov), 0.0, None)
-    touches_zero = np.any(np.abs(V[:, zero]) > NULL_COMPONENT, axis=1)
-    sd = np.where(touches_zero, math.inf, np.sqrt(variance))
-    ok = np.isfinite(sd) & (sd <= 1.0 / IDENTIFIED_MIN_SINGULAR_VALUE)
-    sd = np.where(ok, sd, math.inf)
-    corr = np.full((n, n), math.nan)
-    idx = np.flatnonzero(ok)
-    if idx.size:
-        block = cov[np.ix_(idx, idx)]
-        scale = np.sqrt(np.diag(block))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            c = np.clip(block / np.outer(scale, scale), -1.0, 1.0)
-        np.fill_diagonal(c, 1.0)
-        corr[np.ix_(idx, idx)] = c
-    return Uncertainty(sd, corr, singular, V)
-
-
-@dataclass
-class CalibrationResult:
-    """The fit: best parameters, residuals, uncertainties and the history of every evaluation."""
-
-    parameters: dict[str, float]
-    sigma: dict[str, float]  # 1-sigma in the parameter's unit (Jacobian at the optimum); inf: unidentified
-    correlation: np.ndarray  # in [-1, 1]; NaN in the rows and columns of unidentified parameters
-    features: dict[str, float]
-    residuals: dict[str, float]  # (feature - target) / sigma per target
-    cost: float  # sum of squared residuals / 2
-    history: list[tuple[int, str, float]] = field(default_factory=list)  # (evaluation, stage, cost)
-    evaluations: int = 0
-    replayed: int = 0
-    targets: tuple[Target, ...] = ()
-    at_bound: dict[str, str] = field(default_factory=dict)  # parameter -> "lower" / "upper" it ends on
-    singular_values: tuple[float, ...] = ()  # of the Jacobian in normalised coordinates, descending
-    unidentified: tuple[dict[str, float], ...] = ()  # directions wider than the box: {parameter: component}
-    unidentified_singular_values: tuple[float, ...] = ()  # one per direction of ``unidentified``
-    bounds: dict[str, tuple[float, float]] = field(default_factory=dict)
-
-    @property
-    def identified(self) -> dict[str, bool]:
-        """Per parameter: is its 1-sigma finite (within its search box)."""
-        return {k: math.isfinite(v) for k, v in self.sigma.items()}
-
-    def warnings(self) -> list[str]:
-        """One line per parameter that ends on a bound or is unidentified, and per unidentified direction
-        of two or more parameters."""
-        lines = []
-        for k, side in self.at_bound.items():
-            lo, hi = self.bounds.get(k, (math.nan, math.nan))
-            lines.append(
-                f"{k} = {self.parameters[k]:.6g} ends on its {side} bound (range [{lo:g}, {hi:g}]): the best "
-                "fit may lie beyond it, or the search stopped there in a local minimum; widen the range, "
-                "check the targets or add some"
-            )
-        for k, ok in self.identified.items():
-            if not ok:
-                lines.append(f"{k} is not identified by the targets: its 1-sigma is wider than its range")
-        for s, d in zip(self.unidentified_singular_values, self.unidentified, strict=True):
-            if sum(abs(v) > 1e-3 for v in d.values()) < 2:  # one key alone: said above
-                continue
-            lines.append(
-                f"unidentified direction {_direction(d)} (normalised coordinates, singular value {s:.3g} < "
-                f"{IDENTIFIED_MIN_SINGULAR_VALUE:g}: its 1-sigma is wider than the range)"
-            )
-        return lines
-
-    def uncertainty_record(self) -> dict:
-        """The uncertainty and the flags as JSON-safe values (None: an unidentified sigma, correlation)."""
-        return {
-            "sigma": {k: (v if math.isfinite(v) else None) for k, v in self.sigma.items()},
-            "identified": self.identified,
-            "correlation": [
-                [float(x) if math.isfinite(x) else None for x in row] for row in self.correlation
-            ],
-            "singular_values_unit": list(self.singular_values),
-            "identified_min_singular_value": IDENTIFIED_MIN_SINGULAR_VALUE,
-            "unidentified_directions": [
-                {"singular_value": s, "direction": d}
-                for s, d in zip(self.unidentified_singular_values, self.unidentified, strict=True)
-            ],
-            "at_bound": self.at_bound,
-            "at_bound_tolerance": AT_BOUND_TOLERANCE,
-            "warnings": self.warnings(),
-        }
-
-    def table(self) -> str:
-        """Parameters with their uncertainties and flags, then each target's fit, as plain text (the
-        sentences of :meth:`warnings` apart)."""
-        w = max([len("parameter"), *map(len, self.parameters), *(len(t.label) for t in self.targets)])
-        lines = [f"{'parameter':{w}s} {'value':>14s} {'1-sigma':>12s}"]
-        for k, v in self.parameters.items():
-            sd = f"{self.sigma[k]:12.3g}" if math.isfinite(self.sigma[k]) else f"{'unidentified':>12s}"
-            flag = f"  on its {self.at_bound[k]} bound" if k in self.at_bound else ""
-            lines.append(f"{k:{w}s} {v:14.6g} {sd}{flag}")
-        lines.append("")
-        lines.append(f"{'feature':{w}s} {'target':>14s} {'fitted':>12s} {'residual/sigma':>15s}")
-        for t in self.targets:
-            lines.append(
-                f"{t.label:{w}s} {t.value:14.6g} {self.features[t.label]:12.6g} "
-                f"{self.residuals[t.label]:15.3g}"
-            )
-        lines.append(
-            f"cost (chi^2/2) {self.cost:.4g} after {self.evaluations} evaluations "
-            f"({self.replayed} replayed from the record)"
-        )
-        return "\n".join(lines)
-
-
-def _direction(components: Mapping[str, float]) -> str:
-    """``0.707 a - 0.707 b``: the components above 1e-3, in the parameters' order."""
-    terms = [(v, k) for k, v in components.items() if abs(v) > 1e-3]
-    text = " ".join(f"{'-' if v < 0 else '+'} {abs(v):.3g} {k}" for v, k in terms)
-    return text[2:] if text.startswith("+ ") else text
-
-
 def fingerprint(*parts) -> str:
     """A stable hash of a calibration's definition (what a resumed run must match)."""
     return hashlib.sha256(json.dumps(parts, sort_keys=True, default=repr).encode()).hexdigest()[:16]
@@ -432,52 +265,82 @@ def calibrate(
     names = [p.key for p in parameters]
     if len(set(names)) != len(names):
         raise CalibrationError(f"a parameter is given twice: {names}")
-    cache = cache or EvaluationCache()
-    history: list[tuple[int, str, float]] = []
-    best: dict = {"cost": math.inf, "u": None}
+    run = _Run(evaluate, parameters, targets, cache or EvaluationCache())
+    u_start = np.array([0.5 if p.start is None else p.to_unit(p.start) for p in parameters])
+    global_search(run, u_start, budget, batch, seed)
+    u_best = run.best["u"]
+    if polish and polish_evaluations > 0:
+        u_best = least_squares_polish(run, u_best, len(targets), polish_evaluations, jacobian_step)
+        u_best = run.best["u"]
+    # the Jacobian at the optimum, one batch, in normalised coordinates (columns of comparable size)
+    r0, J, per_unit = _jacobian(run, parameters, targets, u_best, uncertainty_step)
+    return _result(run, parameters, targets, u_best, r0, uncertainty(J), per_unit)
 
-    def point(u) -> dict[str, float]:
-        return {p.key: p.from_unit(x) for p, x in zip(parameters, u, strict=True)}
 
-    def residuals_of(features) -> np.ndarray:
+class _Run:
+    """``run(us, stage) -> residuals``: evaluates points of normalised coordinates through the cache,
+    keeps the history (each distinct point once) and the best point."""
+
+    def __init__(self, evaluate: Callable, parameters: Sequence[Parameter], targets: Sequence[Target], cache):
+        self.evaluate, self.parameters, self.targets, self.cache = evaluate, parameters, targets, cache
+        self.history: list[tuple[int, str, float]] = []
+        self.best: dict = {"cost": math.inf, "u": None}
+        self.seen: set[str] = set()
+
+    def point(self, u) -> dict[str, float]:
+        return {p.key: p.from_unit(x) for p, x in zip(self.parameters, u, strict=True)}
+
+    def residuals_of(self, features) -> np.ndarray:
+        targets = self.targets
         if features is None or any(not math.isfinite(features.get(t.label, math.nan)) for t in targets):
             return np.full(len(targets), FAILED_RESIDUAL)
         return np.array([(features[t.label] - t.value) / t.sigma for t in targets])
 
-    seen: set[str] = set()
-
-    def run(us: list[np.ndarray], stage: str) -> list[np.ndarray]:
-        points = [point(u) for u in us]
-        res = [residuals_of(f) for f in cache.evaluate(evaluate, points)]
+    def __call__(self, us: list[np.ndarray], stage: str) -> list[np.ndarray]:
+        points = [self.point(u) for u in us]
+        res = [self.residuals_of(f) for f in self.cache.evaluate(self.evaluate, points)]
         for u, p, r in zip(us, points, res, strict=True):
             c = 0.5 * float(r @ r)
-            key = cache.key(p)
-            if key not in seen:  # each distinct point once in the history
-                seen.add(key)
-                history.append((len(history) + 1, stage, c))
-            if c < best["cost"]:
-                best.update(cost=c, u=np.array(u, float))
+            key = self.cache.key(p)
+            if key not in self.seen:  # each distinct point once in the history
+                self.seen.add(key)
+                self.history.append((len(self.history) + 1, stage, c))
+            if c < self.best["cost"]:
+                self.best.update(cost=c, u=np.array(u, float))
         return res
 
-    u_start = np.array([0.5 if p.start is None else p.to_unit(p.start) for p in parameters])
-    _global_search(run, u_start, budget, batch, seed)
-    u_best = best["u"]
-    if polish and polish_evaluations > 0:
-        u_best = _polish(run, u_best, len(targets), polish_evaluations, jacobian_step)
-        u_best = best["u"]
-    # the Jacobian at the optimum, one batch, in normalised coordinates (columns of comparable size)
+
+def _jacobian(
+    run: _Run, parameters: Sequence[Parameter], targets: Sequence[Target], u_best: np.ndarray, h: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(residuals at u_best, Jacobian d residual / d u, d parameter / d u)`` by forward differences of
+    ``h`` (one batch)."""
     r0 = run([u_best], "jacobian")[0]
-    steps = [u_best + _step(u_best, j, uncertainty_step) for j in range(len(parameters))]
+    steps = [u_best + step(u_best, j, h) for j in range(len(parameters))]
     rs = run(steps, "jacobian")
-    values = point(u_best)
+    values = run.point(u_best)
     J = np.empty((len(targets), len(parameters)))
     per_unit = np.empty(len(parameters))  # d parameter / d u at the optimum (secant of the step)
     for j, (p, u, r) in enumerate(zip(parameters, steps, rs, strict=True)):
         J[:, j] = (r - r0) / (u[j] - u_best[j])
         per_unit[j] = (p.from_unit(u[j]) - values[p.key]) / (u[j] - u_best[j])
-    unc = uncertainty(J)
+    return r0, J, per_unit
+
+
+def _result(
+    run: _Run,
+    parameters: Sequence[Parameter],
+    targets: Sequence[Target],
+    u_best: np.ndarray,
+    r0: np.ndarray,
+    unc: Uncertainty,
+    per_unit: np.ndarray,
+) -> CalibrationResult:
+    """The fit at ``u_best``: its features (replayed), residuals ``r0``, uncertainty and flags."""
+    names = [p.key for p in parameters]
+    values = run.point(u_best)
     sd = unc.sigma_unit * np.abs(per_unit)
-    features = cache.evaluate(evaluate, [values])[0] or {}
+    features = run.cache.evaluate(run.evaluate, [values])[0] or {}
     at_bound = {}
     for p, u in zip(parameters, u_best, strict=True):
         if u <= AT_BOUND_TOLERANCE:
@@ -492,9 +355,9 @@ def calibrate(
         features={t.label: float(features.get(t.label, math.nan)) for t in targets},
         residuals={t.label: float(x) for t, x in zip(targets, r0, strict=True)},
         cost=0.5 * float(r0 @ r0),
-        history=history,
-        evaluations=len(history),
-        replayed=cache.replayed,
+        history=run.history,
+        evaluations=len(run.history),
+        replayed=run.cache.replayed,
         targets=tuple(targets),
         at_bound=at_bound,
         singular_values=tuple(map(float, unc.singular_values)),
@@ -502,57 +365,3 @@ def calibrate(
         unidentified_singular_values=tuple(s for s, _ in directions),
         bounds={p.key: (p.lower, p.upper) for p in parameters},
     )
-
-
-def _step(u: np.ndarray, j: int, h: float) -> np.ndarray:
-    e = np.zeros_like(u)
-    e[j] = h if u[j] + h <= 1.0 else -h  # stay inside the bounds
-    return e
-
-
-def _global_search(run, u_start: np.ndarray, budget: int, batch: int, seed: int) -> None:
-    try:
-        import nevergrad as ng
-    except ImportError as exc:
-        raise ImportError("calibration needs nevergrad: pip install gearbody[calibrate]") from exc
-    param = ng.p.Array(init=u_start).set_mutation(sigma=0.25).set_bounds(0.0, 1.0)
-    param.random_state.seed(seed)
-    # NGOpt's automatic choice picks a metamodel that fails with numpy 2 in nevergrad 1.0.12 (TypeError in
-    # metamodel.py): differential evolution, robust on small bounded problems and batch-parallel
-    opt = ng.optimizers.registry[OPTIMIZER](parametrization=param, budget=budget, num_workers=batch)
-    opt.suggest(u_start)  # the stated start is the first point asked
-    done = 0
-    while done < budget:
-        n = min(batch, budget - done)
-        cands = [opt.ask() for _ in range(n)]
-        us = [np.clip(np.asarray(c.value, float), 0.0, 1.0) for c in cands]
-        for c, r in zip(cands, run(us, "global"), strict=True):
-            opt.tell(c, 0.5 * float(r @ r))
-        done += n
-
-
-def _polish(run, u0: np.ndarray, n_targets: int, max_evaluations: int, h: float) -> np.ndarray:
-    from scipy.optimize import least_squares
-
-    def fun(u):
-        return run([np.asarray(u, float)], "polish")[0]
-
-    def jac(u):
-        u = np.asarray(u, float)
-        r0 = fun(u)
-        steps = [u + _step(u, j, h) for j in range(u.size)]
-        rs = run(steps, "polish")
-        return np.column_stack(
-            [(r - r0) / (s[j] - u[j]) for j, (s, r) in enumerate(zip(steps, rs, strict=True))]
-        )
-
-    fit = least_squares(
-        fun,
-        u0,
-        jac=jac,
-        bounds=(0.0, 1.0),
-        max_nfev=max(1, max_evaluations // (u0.size + 2)),
-        x_scale=1.0,
-        method="trf",
-    )
-    return np.asarray(fit.x, float)

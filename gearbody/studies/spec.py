@@ -111,44 +111,13 @@ class Study:
                 message names the argument, the count and the limit).
             ScenarioError: unknown scene or bad scenario file.
         """
-        if isinstance(max_cases, bool) or int(max_cases) != max_cases or max_cases < 1:
-            raise SweepSpecError(f"--max-cases must be a whole number >= 1, got {max_cases!r}")
-        if max_cases > MOST_CASES:
-            raise SweepSpecError(
-                f"--max-cases = {max_cases}: at most {MOST_CASES} (a study's cases are listed in memory "
-                "before any runs)"
-            )
-        max_cases = int(max_cases)
+        max_cases = _check_max_cases(max_cases)
         axes = _vary_axes(vary, max_cases)
         rand = _random_axes(random)
-        if rand and samples is None:
-            raise SweepSpecError(f"{rand[0].label}: give the number of draws with --samples N")
-        if samples is not None and (isinstance(samples, bool) or int(samples) != samples or samples < 1):
-            raise SweepSpecError(f"--samples must be a whole number >= 1, got {samples!r}")
-        if samples is not None and not rand:
-            raise SweepSpecError("--samples needs at least one --random KEY=DIST")
-        if seeds is not None and (isinstance(seeds, bool) or int(seeds) != seeds or seeds < 1):
-            raise SweepSpecError(f"--seeds must be a whole number >= 1, got {seeds!r}")
-        if isinstance(study_seed, bool) or int(study_seed) != study_seed or study_seed < 0:
-            raise SweepSpecError(f"--study-seed must be a whole number >= 0, got {study_seed!r}")
-        if not axes and not rand and not seeds:
-            raise SweepSpecError(
-                "nothing to vary: give at least one of --vary, --random (with --samples), --seeds"
-            )
+        _check_draws(axes, rand, samples, seeds, study_seed)
         _check_size(axes, rand, int(samples or 0), int(seeds or 0), max_cases)
-        seen: dict[str, str] = {}
-        for a in (*axes, *rand):
-            if a.key in seen:
-                raise SweepSpecError(f"{a.label}: {a.key} is already varied by {seen[a.key]}")
-            seen[a.key] = a.label
-        if seeds and SEED_KEY in seen:
-            raise SweepSpecError(f"{seen[SEED_KEY]}: {SEED_KEY} is already varied by --seeds")
         base_overrides = tuple(base_overrides)
-        for o in base_overrides:
-            key = parse_override(o)[0]  # ScenarioError naming --set on bad syntax
-            if key in seen or (seeds and key == SEED_KEY):
-                by = seen.get(key, "--seeds")
-                raise SweepSpecError(f"--set {o}: {key} is also varied by {by}; give it in one place")
+        _check_varied_once(axes, rand, seeds, base_overrides)
         label, path = _resolve_scene(scene)
         data = read_scenario_bytes(path)  # a regular file within the size limit, read once
         base = parse_scenario_bytes(data, path)
@@ -303,3 +272,55 @@ def _random_axes(random: Mapping[str, str] | Sequence[str] | None) -> tuple[Rand
     if isinstance(random, Mapping):
         return tuple(parse_random(f"{k}={v}", label=f"random[{k!r}]") for k, v in random.items())
     return tuple(parse_random(t) for t in random)
+
+
+def _check_max_cases(max_cases: Any) -> int:
+    """``--max-cases`` as an int: a whole number from 1 to MOST_CASES."""
+    if isinstance(max_cases, bool) or int(max_cases) != max_cases or max_cases < 1:
+        raise SweepSpecError(f"--max-cases must be a whole number >= 1, got {max_cases!r}")
+    if max_cases > MOST_CASES:
+        raise SweepSpecError(
+            f"--max-cases = {max_cases}: at most {MOST_CASES} (a study's cases are listed in memory "
+            "before any runs)"
+        )
+    return int(max_cases)
+
+
+def _check_draws(
+    axes: Sequence[Axis], rand: Sequence[RandomAxis], samples: Any, seeds: Any, study_seed: Any
+) -> None:
+    """``--samples`` given exactly when a key is random, ``--seeds`` and ``--study-seed`` whole numbers,
+    and something varied."""
+    if rand and samples is None:
+        raise SweepSpecError(f"{rand[0].label}: give the number of draws with --samples N")
+    if samples is not None and (isinstance(samples, bool) or int(samples) != samples or samples < 1):
+        raise SweepSpecError(f"--samples must be a whole number >= 1, got {samples!r}")
+    if samples is not None and not rand:
+        raise SweepSpecError("--samples needs at least one --random KEY=DIST")
+    if seeds is not None and (isinstance(seeds, bool) or int(seeds) != seeds or seeds < 1):
+        raise SweepSpecError(f"--seeds must be a whole number >= 1, got {seeds!r}")
+    if isinstance(study_seed, bool) or int(study_seed) != study_seed or study_seed < 0:
+        raise SweepSpecError(f"--study-seed must be a whole number >= 0, got {study_seed!r}")
+    if not axes and not rand and not seeds:
+        raise SweepSpecError(
+            "nothing to vary: give at least one of --vary, --random (with --samples), --seeds"
+        )
+
+
+def _check_varied_once(
+    axes: Sequence[Axis], rand: Sequence[RandomAxis], seeds: Any, base_overrides: tuple[str, ...]
+) -> None:
+    """Every key varied in one place only: by one --vary or --random, by --seeds (``meta.seed``), and
+    not also set by --set."""
+    seen: dict[str, str] = {}
+    for a in (*axes, *rand):
+        if a.key in seen:
+            raise SweepSpecError(f"{a.label}: {a.key} is already varied by {seen[a.key]}")
+        seen[a.key] = a.label
+    if seeds and SEED_KEY in seen:
+        raise SweepSpecError(f"{seen[SEED_KEY]}: {SEED_KEY} is already varied by --seeds")
+    for o in base_overrides:
+        key = parse_override(o)[0]  # ScenarioError naming --set on bad syntax
+        if key in seen or (seeds and key == SEED_KEY):
+            by = seen.get(key, "--seeds")
+            raise SweepSpecError(f"--set {o}: {key} is also varied by {by}; give it in one place")
