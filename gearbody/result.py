@@ -12,30 +12,18 @@ import math
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
 from .errors import SignalError, StageError
-from .signals import gear_names, stage_prefix, stage_signal
+from .signals import SIGNAL_UNITS, gear_names, stage_signal
+from .stage_meta import PLANET_MESHES, PlanetaryTeeth, StageMeta, stage_meta
 
 FINAL_FRACTION = 0.25
 """Share of the run, at its end, over which 'final' values are taken (the steady period)."""
 
-SIGNAL_UNITS = (("rad_s2", "rad/s^2"), ("m_s2", "m/s^2"), ("_N", "N"), ("_m", "m"), ("rad_s", "rad/s"))
-"""(name suffix, unit) of the signals a spectrum is taken of."""
-
-PLANET_MESHES = ("sun", "ring")
-"""The two meshes of every planet: with the sun and with the ring."""
-
-
-class PlanetaryTeeth(NamedTuple):
-    """Tooth counts of a planetary stage and its number of planets."""
-
-    sun: int
-    planet: int
-    ring: int
-    planets: int
+__all__ = ["FINAL_FRACTION", "PLANET_MESHES", "LabelledSpectrum", "PlanetaryTeeth", "Result", "SIGNAL_UNITS"]
 
 
 @dataclass
@@ -48,6 +36,15 @@ class Result:
     time_s: np.ndarray
     signals: dict[str, np.ndarray]
     meta: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.meta.get("stages"):  # typed stage metadata (a saved run's dicts read back as such)
+            self.meta["stages"] = [stage_meta(st) for st in self.meta["stages"]]
+
+    @property
+    def stages(self) -> tuple[StageMeta, ...]:
+        """The typed metadata of every stage (:mod:`gearbody.stage_meta`), in power-flow order."""
+        return tuple(self.meta.get("stages") or ())
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name == "time_s":
@@ -80,12 +77,8 @@ class Result:
         return self._first_mesh_signal("kd", "kd")
 
     def _first_mesh_signal(self, name: str, planet_suffix: str) -> np.ndarray:
-        if name not in self.signals and 0 in self.planetary_stages:
-            n = self.planetary_teeth(0).planets
-            raise StageError(
-                f"Result signal {name!r}: stage 1 is planetary, with one signal per planet mesh: "
-                f"planet_<n>_sun_mesh_{planet_suffix} and planet_<n>_ring_mesh_{planet_suffix}, n = 1..{n}"
-            )
+        if name not in self.signals and self.stages:
+            self.stages[0].missing_mesh_signal(name, planet_suffix)  # names the stage's own signals
         return self[name]
 
     @property
@@ -108,33 +101,19 @@ class Result:
         return [f"stage {k + 1}" for k in range(self.n_stages)]
 
     def stage_kind(self, stage: int = 0) -> str:
-        """``"parallel"`` (a pinion and a wheel) or ``"planetary"`` (sun, planets, ring, carrier) for stage
-        ``stage`` (0-based)."""
-        return "planetary" if self._stage(stage).get("type") == "planetary" else "parallel"
+        """The type of stage ``stage`` (0-based): ``"parallel"`` (a pinion and a wheel), ``"planetary"``
+        (sun, planets, ring, carrier), or a registered kind's name."""
+        return self._stage(stage).kind
 
     def teeth(self, stage: int = 0) -> tuple[int, int]:
-        """(z_pinion, z_wheel) of parallel stage ``stage`` (0-based); a planetary stage refuses, naming
-        :meth:`planetary_teeth`."""
-        st = self._stage(stage)
-        if self.stage_kind(stage) == "planetary":
-            raise StageError(
-                f"Result.teeth({stage}): stage {stage + 1} is planetary (no pinion and wheel); "
-                f"Result.planetary_teeth({stage}) gives its sun, planet and ring teeth"
-            )
-        return int(st["pinion_teeth"]), int(st["wheel_teeth"])
+        """(z_pinion, z_wheel) of parallel stage ``stage`` (0-based); any other stage refuses, a planetary
+        one naming :meth:`planetary_teeth`."""
+        return self._stage(stage).teeth(stage)
 
     def planetary_teeth(self, stage: int = 0) -> PlanetaryTeeth:
         """(sun, planet, ring, planets): tooth counts and number of planets of planetary stage ``stage``
-        (0-based); a parallel stage refuses, naming :meth:`teeth`."""
-        st = self._stage(stage)
-        if self.stage_kind(stage) != "planetary":
-            raise StageError(
-                f"Result.planetary_teeth({stage}): stage {stage + 1} is a parallel stage; "
-                f"Result.teeth({stage}) gives its pinion and wheel teeth"
-            )
-        return PlanetaryTeeth(
-            int(st["sun_teeth"]), int(st["planet_teeth"]), int(st["ring_teeth"]), int(st["planets"])
-        )
+        (0-based); any other stage refuses, a parallel one naming :meth:`teeth`."""
+        return self._stage(stage).planetary_teeth(stage)
 
     def stage_signal(self, name: str, stage: int = 0) -> np.ndarray:
         """Signal ``name`` of stage ``stage``: ``kd`` of stage 2 is ``stage_2_kd``, its pinion angle
@@ -158,7 +137,13 @@ class Result:
         return t >= t[-1] - fraction * (t[-1] - t[0])
 
     def mesh_frequency_hz(self, stage: int = 0, fraction: float = 0.25) -> float:
-        """Mean mesh frequency of stage ``stage`` over the final ``fraction`` of the run."""
+        """Mean mesh frequency of stage ``stage`` over the final ``fraction`` of the run (a stage without a
+        mesh refuses)."""
+        if stage_signal("mesh_frequency_hz", stage) not in self and stage != 0:
+            self._stage(stage)
+            raise StageError(
+                f"Result.mesh_frequency_hz({stage}): stage {stage + 1} ({self.stage_kind(stage)}) has no mesh"
+            )
         return float(np.mean(self.stage_signal("mesh_frequency_hz", stage)[self.final_window(fraction)]))
 
     # -- what a diagnostician looks at ------------------------------------------------------------
@@ -175,33 +160,7 @@ class Result:
         ``fraction`` of the run. A parallel stage: from the computed pinion angle. A planetary stage: the
         K_d of planet ``planet`` (1..N, default 1) in its ``mesh`` (``"sun"``, default, or ``"ring"``)
         over that mesh's phase as its law computed it (one period per sun or ring tooth)."""
-        from .analysis import fold_over_mesh_period
-
-        win = self.final_window(fraction)
-        if self.stage_kind(stage) == "planetary":
-            name = self._planet_mesh(stage, planet, mesh)
-            phase = self.stage_signal(name + "_phase", stage)[win]
-            kd = self.stage_signal(name + "_kd", stage)[win]
-            return fold_over_mesh_period(kd, 2.0 * math.pi * phase, 1, bins=bins)
-        if planet is not None or mesh is not None:
-            raise StageError(
-                f"Result.fold_kd({stage}, planet={planet!r}, mesh={mesh!r}): stage {stage + 1} is a parallel "
-                "stage with one mesh; planet and mesh apply to planetary stages"
-            )
-        kd = self.stage_signal("kd", stage)[win]
-        angle = self.stage_signal("pinion_angle_rad", stage)[win]
-        return fold_over_mesh_period(kd, angle, self.teeth(stage)[0], bins=bins)
-
-    def _planet_mesh(self, stage: int, planet: int | None, mesh: str | None) -> str:
-        """``planet_<n>_<mesh>_mesh`` of planetary stage ``stage``, checked (default planet 1, sun)."""
-        n = self.planetary_teeth(stage).planets
-        planet = 1 if planet is None else planet
-        mesh = "sun" if mesh is None else mesh
-        if isinstance(planet, bool) or not isinstance(planet, int | np.integer) or not 1 <= planet <= n:
-            raise StageError(f"planet = {planet!r}: stage {stage + 1} has planets 1..{n}")
-        if mesh not in PLANET_MESHES:
-            raise StageError(f"mesh = {mesh!r}: a planet of stage {stage + 1} meshes with 'sun' or 'ring'")
-        return f"planet_{planet}_{mesh}_mesh"
+        return self._stage(stage).fold_kd(self, stage, bins, self.final_window(fraction), planet, mesh)
 
     def spectrum(
         self,
@@ -223,19 +182,17 @@ class Result:
         from .analysis import amplitude_spectrum, gear_train_lines, label_peaks
 
         name = signal or self.vibration_signal_name
-        ring = [k for k in self.planetary_stages if name == stage_signal("ring_sensor_N", k)]
-        if ring:  # a planetary stage's ring sensor: the spectrum of its run plot and report
-            from .analysis.ring_sensor import ring_sensor_spectrum
-
-            rs = ring_sensor_spectrum(self, ring[0])
-            peaks = rs.peaks(min_prominence_db=min_prominence_db, max_peaks=max_peaks)
-            return LabelledSpectrum(signal=name, spectrum=rs.spectrum, peaks=peaks, f_max_hz=rs.f_max_hz)
+        for k, st in enumerate(self.stages):  # a stage's own sensor (a planetary stage's ring sensor)
+            own = st.sensor_spectrum(self, k, name, min_prominence_db, max_peaks)
+            if own is not None:
+                spectrum, peaks, f_max = own
+                return LabelledSpectrum(signal=name, spectrum=spectrum, peaks=peaks, f_max_hz=f_max)
         win = self.final_window(fraction)
         spec = amplitude_spectrum(self[name][win], self.sample_rate_hz, window="hann")
         peaks = []
         f_max = self.sample_rate_hz / 2
-        if self.planetary_stages:
-            f_top = max(self.mesh_frequency_hz(k, fraction) for k in range(self.n_stages))
+        if not self._gear_train:
+            f_top = max(st.mesh_frequency_hz(self, k, fraction) for k, st in enumerate(self.stages))
             if f_top > 0:
                 f_max = min(f_max, (harmonics + 0.5) * f_top)
                 lines = self._compound_lines(fraction, f_max, harmonics, sidebands)
@@ -251,7 +208,7 @@ class Result:
         f_mesh = self.mesh_frequency_hz(0, fraction)
         if f_mesh > 0:
             f_max = min(f_max, (harmonics + 0.5) * f_mesh)
-            teeth = [self.teeth(k) for k in range(self.n_stages)]
+            teeth = [st.gear_pair() for st in self.stages]
             lines = gear_train_lines(
                 f_mesh / teeth[0][0], teeth, f_max, harmonics=harmonics, sidebands=sidebands
             )
@@ -265,15 +222,19 @@ class Result:
             )
         return LabelledSpectrum(signal=name, spectrum=spec, peaks=peaks, f_max_hz=f_max)
 
+    @property
+    def _gear_train(self) -> bool:
+        """True when every stage is a gear pair of one train (its spectrum is labelled as a gear train)."""
+        return all(st.gear_pair() is not None for st in self.stages)
+
     def _compound_lines(self, fraction: float, f_max: float, harmonics: int, sidebands: int) -> list:
-        """Kinematic lines of a drive with planetary stages: each run of consecutive parallel stages as a
-        gear train (shafts named after its pinions and wheels, meshes f_z<stage>), each planetary stage's
-        lines (docs/planetary-lines.md; labelled with their stage when the drive has several)."""
+        """Kinematic lines of a drive whose stages are not all gear pairs: each run of consecutive gear
+        pairs as a gear train (shafts named after its pinions and wheels, meshes f_z<stage>), each other
+        stage's own lines (a planetary stage's, docs/planetary-lines.md; labelled with their stage when
+        the drive has several such stages)."""
         from dataclasses import replace
 
         from .analysis import GearMesh, KinematicSources, Shaft, kinematic_lines
-        from .analysis.planetary_lines import planetary_lines
-        from .analysis.ring_sensor import planetary_sources
 
         lines: list = []
         shafts: list = []
@@ -288,18 +249,18 @@ class Result:
                 shafts.clear()
                 meshes.clear()
 
-        several = len(self.planetary_stages) > 1
-        for k in range(self.n_stages):
-            if self.stage_kind(k) == "planetary":
+        several = sum(st.gear_pair() is None for st in self.stages) > 1
+        for k, st in enumerate(self.stages):
+            pair = st.gear_pair()
+            if pair is None:
                 flush()
-                stage_lines = planetary_lines(planetary_sources(self, k), f_max, harmonics=harmonics)
                 lines.extend(
                     replace(line, label=f"{line.label} (stage {k + 1})") if several else line
-                    for line in stage_lines
+                    for line in st.stage_lines(self, k, f_max, harmonics)
                 )
                 continue
-            z1, z2 = self.teeth(k)
-            f_mesh = self.mesh_frequency_hz(k, fraction)
+            z1, z2 = pair
+            f_mesh = st.mesh_frequency_hz(self, k, fraction)
             if f_mesh <= 0:
                 flush()
                 continue
@@ -336,8 +297,8 @@ class Result:
         from .analysis import separation_stats
 
         sources = {"sources": list(self.meta.get("sources") or [])}
-        if self.planetary_stages:
-            return {**self._planetary_summary(), **self._direction_summary(), **sources}
+        if not self._gear_train:
+            return {**self._compound_summary(), **self._direction_summary(), **sources}
         win = self.final_window()
         sep = separation_stats(self.mesh_force, self.time_s, kd=self.kd)
         speed = (
@@ -407,74 +368,38 @@ class Result:
     @property
     def planetary_stages(self) -> list[int]:
         """Indices of the planetary stages (0-based)."""
-        return [k for k, st in enumerate(self.meta.get("stages") or []) if st.get("type") == "planetary"]
+        return [k for k, st in enumerate(self.stages) if st.kind == "planetary"]
 
-    def _planetary_summary(self) -> dict[str, Any]:
-        """summary() of a drive with planetary stages: per stage the planets' mesh K_d (largest, smallest,
-        final mean), the load-sharing factor (largest final mean planet force over the stage's mean), the
-        separations; parallel stages' K_d; speed and solver statistics."""
+    def _compound_summary(self) -> dict[str, Any]:
+        """summary() of a drive whose stages are not all gear pairs (planetary stages, say): the first
+        stage's K_d over all its meshes (every planet's sun and ring mesh: the keys studies and
+        calibrations read by default), then each stage's own keys (a planetary stage: per mesh type the
+        planets' K_d, load sharing, separations; a later parallel stage: its K_d); speed and solver
+        statistics."""
         from .analysis import separation_stats
 
         win = self.final_window()
         stats = self.meta.get("solver_statistics", {})
         t = float(self.time_s[-1] - self.time_s[0])
         out: dict[str, Any] = {"scene": self.meta.get("scene")}
-        # the first stage's K_d over all its meshes (every planet's sun and ring mesh): the keys studies
-        # and calibrations read by default
-        first = self.meta["stages"][0]
-        names = (
-            [f"planet_{p + 1}_{m}_mesh" for p in range(first["planets"]) for m in ("sun", "ring")]
-            if first.get("type") == "planetary"
-            else ["mesh"]
-        )
-        kd = np.array([self[n + "_kd" if n != "mesh" else "kd"] for n in names])
-        seps = [
-            separation_stats(self[n + "_force_N"], self.time_s, kd=self[n + "_kd" if n != "mesh" else "kd"])
-            for n in names
-        ]
-        out.update(
-            {
-                "kd_max": float(kd.max()),
-                "kd_min": float(kd.min()),
-                "kd_max_final": float(kd[:, win].max()),
-                "kd_mean_final": float(kd[:, win].mean()),
-                "kd_above_2": bool(kd.max() > 2.0),
-                "separation_fraction": float(max(s.separated_fraction for s in seps)),
-                "contact_losses": int(sum(s.contact_losses for s in seps)),
-                "mesh_frequency_hz": float(np.mean(self["mesh_frequency_hz"][win])),
-            }
-        )
-        for k, meta in enumerate(self.meta["stages"]):
-            prefix = stage_prefix(k)
-            if meta.get("type") != "planetary":
-                if k > 0:
-                    kd = self[prefix + "kd"]
-                    out[f"{prefix}kd_max"], out[f"{prefix}kd_min"] = float(np.max(kd)), float(np.min(kd))
-                    out[f"{prefix}kd_max_final"] = float(np.max(kd[win]))
-                    out[f"{prefix}kd_mean_final"] = float(np.mean(kd[win]))
-                continue
-            for mesh in ("sun", "ring"):
-                names = [f"{prefix}planet_{p + 1}_{mesh}_mesh" for p in range(meta["planets"])]
-                kd = np.array([self[n + "_kd"] for n in names])
-                means = kd[:, win].mean(axis=1)
-                seps = [
-                    separation_stats(self[n + "_force_N"], self.time_s, kd=self[n + "_kd"]) for n in names
-                ]
-                out[f"{prefix}{mesh}_mesh_kd_max"] = float(kd.max())
-                out[f"{prefix}{mesh}_mesh_kd_max_final"] = float(kd[:, win].max())
-                out[f"{prefix}{mesh}_mesh_kd_min"] = float(kd.min())
-                out[f"{prefix}{mesh}_mesh_kd_mean_final"] = float(means.mean())
-                mean = means.mean()  # no load: no sharing to speak of (NaN)
-                out[f"{prefix}{mesh}_mesh_load_sharing_factor"] = (
-                    float(means.max() / mean) if mean != 0.0 else float("nan")
-                )
-                out[f"{prefix}{mesh}_mesh_separation_fraction"] = float(
-                    max(s.separated_fraction for s in seps)
-                )
-                out[f"{prefix}{mesh}_mesh_contact_losses"] = int(sum(s.contact_losses for s in seps))
-            if k > 0:
-                out[f"{prefix}mesh_frequency_hz"] = float(np.mean(self[prefix + "mesh_frequency_hz"][win]))
-            out[f"{prefix}rated_mesh_force_N"] = float(meta["rated_mesh_force_N"])
+        first = self.stages[0].mesh_signals(0)
+        if first:
+            kd = np.array([self[kd_name] for kd_name, _ in first])
+            seps = [separation_stats(self[force], self.time_s, kd=self[kd_name]) for kd_name, force in first]
+            out.update(
+                {
+                    "kd_max": float(kd.max()),
+                    "kd_min": float(kd.min()),
+                    "kd_max_final": float(kd[:, win].max()),
+                    "kd_mean_final": float(kd[:, win].mean()),
+                    "kd_above_2": bool(kd.max() > 2.0),
+                    "separation_fraction": float(max(s.separated_fraction for s in seps)),
+                    "contact_losses": int(sum(s.contact_losses for s in seps)),
+                    "mesh_frequency_hz": float(np.mean(self["mesh_frequency_hz"][win])),
+                }
+            )
+        for k, st in enumerate(self.stages):
+            out.update(st.summary(self, k, win))
         out.update(
             {
                 "mean_speed_rad_s": float(np.mean(self["motor_speed_rad_s"][win])),
@@ -506,8 +431,8 @@ class Result:
         from ``gearbody.engine.natural_frequencies`` or measured, for the natural-frequency features)."""
         from .analysis.features import Record
 
-        if self.meta.get("stages"):
-            teeth = self.teeth(0) if self.stage_kind(0) == "parallel" else (None, None)
+        if self.stages:
+            teeth = self.stages[0].gear_pair() or (None, None)
         else:  # a result put together by hand: the teeth its metadata gives
             teeth = (self.meta.get("pinion_teeth"), self.meta.get("wheel_teeth"))
         return Record(
@@ -541,8 +466,8 @@ class Result:
             paths += write_planetary_plots(self, out_dir)
         return paths
 
-    def _stage(self, stage: int) -> dict[str, Any]:
-        stages = self.meta.get("stages") or []
+    def _stage(self, stage: int) -> StageMeta:
+        stages = self.stages
         if isinstance(stage, bool) or not isinstance(stage, int | np.integer) or not 0 <= stage < len(stages):
             raise StageError(
                 f"stage = {stage!r}: the result has {len(stages)} stage(s), 0..{len(stages) - 1} (0-based)"
@@ -600,6 +525,8 @@ class LabelledSpectrum:
 
 
 def _jsonable(obj: Any) -> Any:
+    if isinstance(obj, StageMeta):
+        return obj.to_dict()
     if isinstance(obj, np.generic):
         return obj.item()
     if isinstance(obj, np.ndarray):

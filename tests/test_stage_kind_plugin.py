@@ -13,7 +13,7 @@ import pytest
 
 import gearbody
 from gearbody.assembly.system import Body, SliceTerm
-from gearbody.errors import InputError, ScenarioError
+from gearbody.errors import InputError, ScenarioError, StageError
 from gearbody.model.kinds import register_stage_kind, stage_kind, unregister_stage_kind
 from gearbody.model.params import Node, param
 from gearbody.signals import stage_prefix
@@ -163,3 +163,54 @@ def test_registration_names_what_is_wrong():
         register_stage_kind("parallel", layout=None)
     with pytest.raises(ValueError, match="KIND must be 'pulley'"):
         register_stage_kind("pulley", BeltStage)
+
+
+def test_every_result_method_works_for_the_kind_or_refuses_in_one_line(belt_kind, tmp_path):
+    result = gearbody.simulate(_one_stage_and_belt(0.25))
+    assert result.stage_kind(1) == "belt" and result.stages[1].kind == "belt"
+    assert result.teeth(0) == (result.meta["pinion_teeth"], result.meta["wheel_teeth"])
+    for call, words in (
+        (lambda: result.teeth(1), "stage 2 is a belt stage"),
+        (lambda: result.planetary_teeth(1), "stage 2 is a belt stage"),
+        (lambda: result.fold_kd(1), "stage 2 is a belt stage"),
+        (lambda: result.mesh_frequency_hz(1), "stage 2 (belt) has no mesh"),
+    ):
+        with pytest.raises(StageError) as exc:
+            call()
+        assert "\n" not in str(exc.value) and words in str(exc.value), str(exc.value)
+    summary = result.summary()  # the first stage's K_d keys, then every stage's own
+    assert summary["kd_max"] == pytest.approx(float(np.max(result["kd"])))
+    spectrum = result.spectrum()  # the gear pair's lines; the belt adds none
+    assert spectrum.peaks and any("f_z1" in " ".join(p.labels) for p in spectrum.peaks if p.labels)
+    assert result.fold_kd(0).mean.size == 100
+    written = {p.name for p in result.plot(tmp_path)}
+    assert {"kd_time.png", "kd_folded.png", "spectrum.png"} <= written
+    path = result.save_npz(tmp_path / "belt.npz")
+    again = gearbody.Result.load_npz(path)
+    assert again.stages[1] == result.stages[1] == {"type": "belt", "ratio": pytest.approx(2.4)}
+
+
+def test_no_module_outside_the_kinds_own_branches_on_a_stage_type():
+    """Code that works for every stage asks the stage's kind; only a kind's own modules know its class."""
+    import sys
+    from pathlib import Path
+
+    root = Path(gearbody.__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "benchmarks"))
+    try:
+        from code_shape import STAGE_KIND
+    finally:
+        sys.path.pop(0)
+    own = {  # the modules of the parallel and planetary kinds (each registers its hooks at its end)
+        "model/scenario.py",
+        "model/planetary.py",
+        "reports/mesh/planetary.py",
+    }
+    found = [
+        f"{path.relative_to(root / 'gearbody')}:{n}: {line.strip()}"
+        for path in sorted((root / "gearbody").rglob("*.py"))
+        if str(path.relative_to(root / "gearbody")) not in own
+        for n, line in enumerate(path.read_text().splitlines(), 1)
+        if STAGE_KIND.search(line) and not line.lstrip().startswith("#")
+    ]
+    assert found == []

@@ -98,31 +98,21 @@ def execute(args) -> int:
 
 
 def _report(args, scenario, stages, out) -> list:
-    """Print each stage's report and write its plot in ``out`` (None: no plots); the plots written."""
-    from gearbody.reports.mesh import damage_windows, static_transmission_error, stiffness_cycle, summary_text
-    from gearbody.reports.mesh.figure import plot_planetary_stage, plot_stage
-    from gearbody.reports.mesh.planetary import (
-        is_planetary,
-        planetary_damage_windows,
-        planetary_static_transmission_errors,
-        planetary_stiffness_cycles,
-        planetary_summary_text,
-    )
+    """Print each stage's report and write its plot in ``out`` (None: no plots); the plots written. Each
+    stage's kind makes its own report (its ``mesh_report``); a kind without one is named and skipped."""
+    import gearbody.reports.mesh.kinds  # noqa: F401  (the kinds' mesh reports register on import)
+    from gearbody.model.kinds import stage_kind
 
     print(f"{scenario.meta.title}")
     written = []
     for k in stages:
         path = None if args.no_plots else out / f"mesh_stage{k + 1}.png"
-        if is_planetary(scenario, k):
-            cycles, windows = planetary_stiffness_cycles(scenario, k), planetary_damage_windows(scenario, k)
-            tes = planetary_static_transmission_errors(scenario, k, args.load)
-            print(planetary_summary_text(scenario, k, args.load, cycles=cycles, windows=windows, tes=tes))
-            if path is not None:
-                written.append(plot_planetary_stage(scenario, k, path, cycles, windows, tes))
+        kind = stage_kind(scenario.stages[k])
+        if kind.mesh_report is None:
+            print(f"stage {k + 1} (type {kind.name!r}): its kind has no mesh report")
             continue
-        cycle, windows = stiffness_cycle(scenario, k), damage_windows(scenario, k)
-        te = static_transmission_error(scenario, k, args.load)
-        print(summary_text(scenario, k, args.load, cycle=cycle, windows=windows, te=te))
-        if path is not None:
-            written.append(plot_stage(scenario, k, path, cycle, windows, te))
+        text, plot = kind.mesh_report(scenario, k, args.load, path)
+        print(text)
+        if plot is not None:
+            written.append(plot)
     return written

@@ -56,10 +56,6 @@ def execute(args) -> int:
 
 
 def _first_stage_input(stage) -> tuple[float, str]:
-    """(mesh periods per revolution of the first stage's input, the table's footnote), from the stage
-    (its model's :meth:`mesh_periods_per_revolution`: a parallel stage's z1, a planetary one's f_m / f_in)."""
-    per_rev, how = stage.mesh_periods_per_revolution()
-    return per_rev, (
-        "(w(k f_z) = speed of the first stage's input at which the k-th mesh harmonic k f_z = k "
-        f"{per_rev:.5g} w / 2 pi meets f_n; {how})"
-    )
+    """(mesh periods per revolution of the first stage's input, the table's footnote), from the stage's
+    model (:meth:`mesh_periods_per_revolution`: a parallel stage's z1, a planetary one's f_m / f_in)."""
+    return stage.mesh_periods_per_revolution()

@@ -55,6 +55,8 @@ class StageKind:
       ``bodies(drive)`` (see :mod:`gearbody.render.drive`); None: ``gearbody render`` refuses the drive.
       Optionally ``render_parts.teeth(table)``: the teeth a saved stage table states (a tuple), by which
       a result of another drive is refused.
+    - ``mesh_report(scenario, k, load_fraction, path)``: ``gearbody mesh``'s report of the stage, (its
+      text, the plot written at ``path`` or None when ``path`` is None).
     """
 
     name: str
@@ -74,6 +76,7 @@ class StageKind:
     check_result: Callable | None = None
     nominal_speeds: Callable | None = None
     render_parts: Callable | None = None
+    mesh_report: Callable | None = None
 
 
 _KINDS: dict[str, StageKind] = {}

@@ -384,12 +384,13 @@ class PlanetaryStage(Node):
         return 2 * self.planets
 
     def mesh_periods_per_revolution(self) -> tuple[float, str]:
-        """(mesh periods per revolution of the input member, how they follow from the stage): f_m / f_in
-        of rigid rolling (Willis), f_m = z_s |w_s - w_c| / 2 pi."""
+        """(mesh periods per revolution of the input member: f_m / f_in of rigid rolling (Willis),
+        f_m = z_s |w_s - w_c| / 2 pi; the footnote of ``gearbody modes`` that says so)."""
         per_rev = 2 * math.pi * self.mesh_frequency_hz(1.0)
         return per_rev, (
-            f"f_m = z_s |w_s - w_c| / 2 pi = {per_rev:.5g} w / 2 pi with the {self.fixed} fixed, "
-            f"z_s/z_p/z_r = {self.sun.teeth}/{self.planet.teeth}/{self.ring.teeth}"
+            f"(w(k f_z) = {self.input} speed (the planetary first stage's input) at which the k-th mesh "
+            f"harmonic k f_m meets f_n; f_m = z_s |w_s - w_c| / 2 pi = {per_rev:.5g} w / 2 pi with the "
+            f"{self.fixed} fixed, z_s/z_p/z_r = {self.sun.teeth}/{self.planet.teeth}/{self.ring.teeth})"
         )
 
     @property

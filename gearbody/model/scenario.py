@@ -81,9 +81,12 @@ class Stage(Node):
         return self.pinion.teeth
 
     def mesh_periods_per_revolution(self) -> tuple[float, str]:
-        """(mesh periods per revolution of the input, how they follow from the stage): z1."""
+        """(mesh periods per revolution of the input: z1, the footnote of ``gearbody modes`` that says so)."""
         z1 = self.pinion.teeth
-        return z1, f"the pinion's teeth z1 = {z1}"
+        return (
+            z1,
+            f"(w(k f_z) = pinion speed at which the k-th mesh harmonic z1 w k / 2 pi meets f_n; z1 = {z1})",
+        )
 
     @property
     def input_arm_m(self) -> float:

@@ -38,9 +38,8 @@ def write_planetary_plots(result: Result, out_dir: str | Path) -> list[Path]:
     title = result.meta.get("title", result.meta.get("scene", ""))
     paths = []
     win = result.final_window()
-    for k, meta in enumerate(result.meta["stages"]):
-        if meta.get("type") != "planetary":
-            continue
+    for k in result.planetary_stages:
+        meta = result.stages[k]
         prefix = stage_prefix(k)
         tag = stage_file_tag(k)
         n = meta["planets"]

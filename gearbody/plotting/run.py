@@ -30,8 +30,8 @@ def parallel_stage_plot_names(result: Result) -> list[str]:
     """The file names :func:`write_plots` gives the K_d plots of the result's parallel stages: stage 1
     ``kd_time.png``, ``kd_folded.png``; stage k > 1 ``kd_time_stage_k.png``, ``kd_folded_stage_k.png``."""
     names = []
-    for k in range(result.n_stages):
-        if result.stage_kind(k) == "parallel":
+    for k, st in enumerate(result.stages):
+        if st.has_kd_plots:
             tag = stage_file_tag(k)
             names += [f"kd_time{tag}.png", f"kd_folded{tag}.png"]
     return names
@@ -44,10 +44,10 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
     out = Path(out_dir)
     title = result.meta.get("title", result.meta.get("scene", ""))
     paths: list[Path] = []
-    for k in range(result.n_stages):
-        if result.stage_kind(k) == "parallel":
+    for k, st in enumerate(result.stages):
+        if st.has_kd_plots:
             paths += _stage_kd_plots(result, k, out, title)
-    if result.stage_kind(0) == "parallel":
+    if result.stages[0].gear_pair() is not None:
         paths.append(_spectrum_plot(result, out, title))
     # parallel gears on lateral bearings (a drive with planetary stages has none: its bearing forces are
     # the planetary members')

@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from gearbody.assembly.planetary_layout import contact_ratios, layout_from_stage, ring_wheel_teeth
+from gearbody.model.planetary import PlanetaryStage
 from gearbody.physics import mesh as _mesh
 from gearbody.physics.mesh_stiffness import static_transmission_error_m
 from gearbody.physics.planetary import planet_mesh_phases
@@ -28,7 +29,6 @@ from .text import _stats, format_table
 
 __all__ = [
     "PLANET_MESHES",
-    "is_planetary",
     "planetary_damage_windows",
     "planetary_geometry_table",
     "planetary_static_transmission_errors",
@@ -40,14 +40,9 @@ PLANET_MESHES = ("sun", "ring")
 """A planet's two meshes, by the central member it meshes with."""
 
 
-def is_planetary(scenario, stage: int) -> bool:
-    """Whether stage ``stage`` (0-based) of the scenario is a planetary stage."""
-    return getattr(get_stage(scenario, stage), "type", "") == "planetary"
-
-
 def _planetary(scenario, stage: int):
     st = get_stage(scenario, stage)
-    if getattr(st, "type", "") != "planetary":
+    if not isinstance(st, PlanetaryStage):
         raise ValueError(f"stage {stage + 1} is no planetary stage (the parallel report: reports.mesh)")
     return st
 
