@@ -45,3 +45,28 @@ def test_the_physics_errors_stay_value_errors_and_are_input_errors():
 
     for cls in (GearGeometryError, PlanetaryGeometryError, PlanetaryModalError):
         assert issubclass(cls, InputError) and issubclass(cls, ValueError) and cls.exit_code == 2
+
+
+def test_the_analysis_namespace_refuses_bad_arguments_with_input_errors():
+    """What a user calls in gearbody.analysis refuses a bad argument with an InputError (still a
+    ValueError): no bare ValueError is raised there."""
+    import re
+    from pathlib import Path
+
+    import gearbody
+    from gearbody.analysis import amplitude_spectrum
+    from gearbody.errors import InputError
+
+    folder = Path(gearbody.__file__).parent / "analysis"
+    bare = [
+        f"{p.name}:{n}"
+        for p in sorted(folder.glob("*.py"))
+        for n, line in enumerate(p.read_text().splitlines(), 1)
+        if re.search(r"raise ValueError\(", line)
+    ]
+    assert bare == []
+    import numpy as np
+    import pytest
+
+    with pytest.raises(InputError):
+        amplitude_spectrum(np.zeros(8), -1.0)

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from ..errors import InputError
+
 
 def is_real(value: object) -> bool:
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
@@ -13,11 +15,11 @@ def is_real(value: object) -> bool:
 
 def positive_frequency(name: str, value: float) -> float:
     if not (is_real(value) and math.isfinite(value) and value > 0):
-        raise ValueError(f"{name} must be a positive frequency [Hz], got {value!r}")
+        raise InputError(f"{name} must be a positive frequency [Hz], got {value!r}")
     return float(value)
 
 
 def integer_at_least(name: str, value: int, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+        raise InputError(f"{name} must be an integer >= {minimum}, got {value!r}")
     return int(value)

@@ -22,6 +22,8 @@ from functools import lru_cache
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+from ..errors import InputError
+
 __all__ = ["KERNEL_HALF_WIDTH_SAMPLES", "band_limited_samples", "level_crossings"]
 
 KERNEL_HALF_WIDTH_SAMPLES = 32
@@ -108,9 +110,9 @@ def band_limited_samples(
     x = np.asarray(x_fine, float)
     M = int(oversampling)
     if M < 2:
-        raise ValueError(f"oversampling must be >= 2, got {oversampling}")
+        raise InputError(f"oversampling must be >= 2, got {oversampling}")
     if t.ndim != 1 or x.shape != t.shape or t.size < 4:
-        raise ValueError("t_fine_s and x_fine must be 1-D arrays of equal length >= 4")
+        raise InputError("t_fine_s and x_fine must be 1-D arrays of equal length >= 4")
     dt = (t[-1] - t[0]) / (t.size - 1)
     rate = 1.0 / (M * dt)
     half_w = KERNEL_HALF_WIDTH_SAMPLES / rate

@@ -29,6 +29,8 @@ from numpy.typing import ArrayLike, NDArray
 from gearbody.analysis._validate import integer_at_least, is_real
 from gearbody.analysis.spectrum import Spectrum, amplitude_spectrum
 
+from ..errors import InputError
+
 __all__ = ["MIN_CARRIER_REVOLUTIONS", "CarrierWindow", "carrier_order_spectrum", "carrier_window"]
 
 MIN_CARRIER_REVOLUTIONS = 4
@@ -123,7 +125,7 @@ class CarrierWindow:
 
 def _finite(name: str, value: float) -> float:
     if not (is_real(value) and math.isfinite(value)):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
+        raise InputError(f"{name} must be a finite number, got {value!r}")
     return float(value)
 
 
@@ -152,18 +154,18 @@ def carrier_window(
     t = np.asarray(time_s, dtype=float)
     phi = np.asarray(carrier_angle_rad, dtype=float)
     if t.ndim != 1 or t.size < 2 or phi.shape != t.shape:
-        raise ValueError(
+        raise InputError(
             f"time_s and carrier_angle_rad must be 1-D of one length >= 2, got shapes {t.shape} and "
             f"{phi.shape}"
         )
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(phi))):
-        raise ValueError("time_s and carrier_angle_rad must be finite")
+        raise InputError("time_s and carrier_angle_rad must be finite")
     if not np.all(np.diff(t) > 0):
-        raise ValueError("time_s must be strictly increasing")
+        raise InputError("time_s must be strictly increasing")
     change_s = _finite("change_s", change_s)
     settle_factor = _finite("settle_factor", settle_factor)
     if settle_factor < 1:
-        raise ValueError(f"settle_factor must be >= 1, got {settle_factor!r}")
+        raise InputError(f"settle_factor must be >= 1, got {settle_factor!r}")
     min_revolutions = integer_at_least("min_revolutions", min_revolutions, 1)
     change = min(max(change_s, float(t[0])), float(t[-1]))
     steady_from = float(t[-1]) - (float(t[-1]) - change) / settle_factor
@@ -222,14 +224,14 @@ def carrier_order_spectrum(
     y = np.asarray(signal, dtype=float)
     phi = np.asarray(carrier_angle_rad, dtype=float)
     if not isinstance(window, CarrierWindow):
-        raise ValueError(f"window must be a CarrierWindow, got {type(window).__name__}")
+        raise InputError(f"window must be a CarrierWindow, got {type(window).__name__}")
     if y.shape != phi.shape or y.ndim != 1 or y.size < window.stop:
-        raise ValueError(
+        raise InputError(
             f"signal and carrier_angle_rad must be 1-D of one length >= window.stop = {window.stop}, got "
             f"shapes {y.shape} and {phi.shape}"
         )
     if not (is_real(sample_rate_hz) and sample_rate_hz > 0 and math.isfinite(sample_rate_hz)):
-        raise ValueError(f"sample_rate_hz must be a positive number [Hz], got {sample_rate_hz!r}")
+        raise InputError(f"sample_rate_hz must be a positive number [Hz], got {sample_rate_hz!r}")
     y = y[window.start : window.stop]
     if not window.revolutions:
         return amplitude_spectrum(y, sample_rate_hz, window="hann")

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import InputError
+
 __all__ = [
     "INSTABILITY_KD",
     "FoldedSignal",
@@ -30,20 +32,20 @@ INSTABILITY_KD: float = 2.0
 def _as_1d(name: str, values: ArrayLike) -> NDArray[np.float64]:
     array = np.asarray(values, dtype=float)
     if array.ndim != 1:
-        raise ValueError(f"{name} must be 1-D, got shape {array.shape}")
+        raise InputError(f"{name} must be 1-D, got shape {array.shape}")
     return array
 
 
 def _same_length(**arrays: NDArray[np.float64]) -> None:
     lengths = {name: a.size for name, a in arrays.items()}
     if len(set(lengths.values())) > 1:
-        raise ValueError(f"arrays must have equal lengths, got {lengths}")
+        raise InputError(f"arrays must have equal lengths, got {lengths}")
 
 
 def mesh_phase(pinion_angle_rad: ArrayLike, pinion_teeth: int) -> NDArray[np.float64]:
     """Mesh phase p = frac(phi_1 * z_1 / (2 pi)) in [0, 1) from the pinion angle phi_1 [rad]."""
     if int(pinion_teeth) != pinion_teeth or pinion_teeth < 1:
-        raise ValueError(f"pinion_teeth must be a positive integer, got {pinion_teeth!r}")
+        raise InputError(f"pinion_teeth must be a positive integer, got {pinion_teeth!r}")
     cycles = np.asarray(pinion_angle_rad, dtype=float) * int(pinion_teeth) / (2.0 * np.pi)
     phase = cycles - np.floor(cycles)
     # floor can leave exactly 1.0 after rounding for tiny negative inputs
@@ -93,7 +95,7 @@ def fold_over_mesh_period(
         bins: number of equal-width bins over one mesh period.
     """
     if int(bins) != bins or bins < 1:
-        raise ValueError(f"bins must be a positive integer, got {bins!r}")
+        raise InputError(f"bins must be a positive integer, got {bins!r}")
     bins = int(bins)
     y = _as_1d("values", values)
     angle = _as_1d("pinion_angle_rad", pinion_angle_rad)
@@ -158,7 +160,7 @@ def _time_weights(time_s: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.zeros_like(time_s)
     dt = np.diff(time_s)
     if np.any(dt < 0):
-        raise ValueError("time_s must be non-decreasing")
+        raise InputError("time_s must be non-decreasing")
     weights = np.zeros_like(time_s)
     weights[:-1] += 0.5 * dt
     weights[1:] += 0.5 * dt
@@ -236,9 +238,9 @@ def periods_stats(
     _same_length(kd=values, time_s=time)
     edges = _as_1d("boundaries_s", boundaries_s)
     if edges.size < 2:
-        raise ValueError("boundaries_s needs at least two times (start and end of one period)")
+        raise InputError("boundaries_s needs at least two times (start and end of one period)")
     if np.any(np.diff(edges) <= 0):
-        raise ValueError("boundaries_s must be strictly increasing")
+        raise InputError("boundaries_s must be strictly increasing")
 
     result: list[dict[str, float | int]] = []
     last = edges.size - 2

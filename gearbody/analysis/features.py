@@ -48,6 +48,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
 from .dynamic_factor import separation_stats
 from .feature_functions import (
     KD_STATISTICS,
@@ -232,7 +233,7 @@ def register_feature(name: str, kind: FeatureKind) -> None:
     """Make feature ``name`` known to every feature user (``Result.features``, the studies' --feature,
     sensitivity and calibration targets): a new analysis is one module that registers its kind."""
     if not name.isidentifier():
-        raise ValueError(f"a feature name is an identifier, got {name!r}")
+        raise InputError(f"a feature name is an identifier, got {name!r}")
     FEATURE_KINDS[name] = kind
     FEATURES[name] = kind.options
 

@@ -21,6 +21,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import InputError
+
 if TYPE_CHECKING:
     from gearbody.analysis.tsa import SynchronousAverage
 
@@ -46,16 +48,16 @@ __all__ = [
 def _as_1d(name: str, values: ArrayLike, min_size: int = 2) -> NDArray[np.float64]:
     array = np.asarray(values, dtype=float)
     if array.ndim != 1 or array.size < min_size:
-        raise ValueError(f"{name} must be 1-D with at least {min_size} samples, got shape {array.shape}")
+        raise InputError(f"{name} must be 1-D with at least {min_size} samples, got shape {array.shape}")
     if not np.all(np.isfinite(array)):
         first = int(np.flatnonzero(~np.isfinite(array))[0])
-        raise ValueError(f"{name} must be finite, sample {first} is {array[first]!r}")
+        raise InputError(f"{name} must be finite, sample {first} is {array[first]!r}")
     return array
 
 
 def _check_teeth(teeth: int) -> int:
     if isinstance(teeth, bool) or int(teeth) != teeth or teeth < 1:
-        raise ValueError(f"teeth must be a positive integer, got {teeth!r}")
+        raise InputError(f"teeth must be a positive integer, got {teeth!r}")
     return int(teeth)
 
 
@@ -65,7 +67,7 @@ def _central_moments(name: str, values: ArrayLike, order: int) -> tuple[float, f
     d = x - x.mean()
     m2 = float(np.mean(d * d))
     if not m2 > 0.0:
-        raise ValueError(f"{name} has zero variance (constant signal), its normalised moments are undefined")
+        raise InputError(f"{name} has zero variance (constant signal), its normalised moments are undefined")
     return m2, float(np.mean(d**order))
 
 
@@ -91,7 +93,7 @@ def crest_factor(signal: ArrayLike) -> float:
     x = _as_1d("signal", signal, min_size=1)
     value = rms(x)
     if not value > 0.0:
-        raise ValueError("signal is all zero, its crest factor is undefined")
+        raise InputError("signal is all zero, its crest factor is undefined")
     return float(np.max(np.abs(x)) / value)
 
 
@@ -112,7 +114,7 @@ def fm0(tsa: ArrayLike, teeth: int) -> float:
     x = _as_1d("tsa", tsa)
     n = x.size
     if n < 2 * teeth:
-        raise ValueError(
+        raise InputError(
             f"tsa must have at least 2 * teeth = {2 * teeth} points per revolution to hold the mesh order, "
             f"got {n}"
         )
@@ -124,7 +126,7 @@ def fm0(tsa: ArrayLike, teeth: int) -> float:
     total = float(np.sum(amplitude))
     spread = peak_to_peak(x)
     if not total > 1e-12 * spread:  # nothing but rounding at the mesh orders (or a constant tsa)
-        raise ValueError(
+        raise InputError(
             f"tsa has no content at the mesh orders (sum of amplitudes {total:.3g}), FM0 is undefined"
         )
     return spread / total
@@ -147,13 +149,13 @@ def m8a(difference: ArrayLike) -> float:
 
 def _records(residual_records: Sequence[ArrayLike] | NDArray[np.float64]) -> list[NDArray[np.float64]]:
     if isinstance(residual_records, np.ndarray) and residual_records.ndim == 1:
-        raise ValueError(
+        raise InputError(
             "residual_records must be a sequence of 1-D records (or a 2-D array, one record per row), "
             f"got a 1-D array of shape {residual_records.shape}; wrap a single record as [record]"
         )
     records = [_as_1d(f"residual_records[{j}]", r) for j, r in enumerate(residual_records)]
     if not records:
-        raise ValueError("residual_records must hold at least 1 record, got 0")
+        raise InputError("residual_records must hold at least 1 record, got 0")
     return records
 
 
@@ -191,7 +193,7 @@ def energy_ratio(difference: ArrayLike, regular: ArrayLike) -> float:
     r = _as_1d("regular", regular, min_size=1)
     denominator = rms(r)
     if not denominator > 0.0:
-        raise ValueError("regular is all zero, the energy ratio is undefined")
+        raise InputError("regular is all zero, the energy ratio is undefined")
     return rms(d) / denominator
 
 
@@ -220,23 +222,23 @@ def sideband_energy_ratio(
     f = _as_1d("spectrum_frequency_hz", spectrum_frequency_hz)
     a = _as_1d("spectrum_amplitude", spectrum_amplitude)
     if f.size != a.size:
-        raise ValueError(
+        raise InputError(
             f"spectrum_frequency_hz and spectrum_amplitude must have equal lengths, got {f.size} and {a.size}"
         )
     step = np.diff(f)
     if np.any(step <= 0.0):
-        raise ValueError("spectrum_frequency_hz must be strictly increasing")
+        raise InputError("spectrum_frequency_hz must be strictly increasing")
     if isinstance(n_sidebands, bool) or int(n_sidebands) != n_sidebands or n_sidebands < 1:
-        raise ValueError(f"n_sidebands must be a positive integer, got {n_sidebands!r}")
+        raise InputError(f"n_sidebands must be a positive integer, got {n_sidebands!r}")
     resolution_hz = float(np.median(step))
     if not shaft_hz >= resolution_hz:
-        raise ValueError(
+        raise InputError(
             f"shaft_hz must be >= the spectrum resolution {resolution_hz:.6g} Hz to separate the sidebands, "
             f"got {shaft_hz!r}"
         )
     low_hz, high_hz = mesh_hz - n_sidebands * shaft_hz, mesh_hz + n_sidebands * shaft_hz
     if not (low_hz >= f[0] - 0.5 * resolution_hz and high_hz <= f[-1] + 0.5 * resolution_hz):
-        raise ValueError(
+        raise InputError(
             f"mesh_hz +- n_sidebands * shaft_hz = {low_hz:.6g} .. {high_hz:.6g} Hz must lie within the "
             f"spectrum {f[0]:.6g} .. {f[-1]:.6g} Hz (mesh_hz={mesh_hz!r}, shaft_hz={shaft_hz!r}, "
             f"n_sidebands={n_sidebands!r})"
@@ -247,7 +249,7 @@ def sideband_energy_ratio(
 
     carrier = at(mesh_hz)
     if not carrier > 0.0:
-        raise ValueError(f"spectrum amplitude at mesh_hz={mesh_hz!r} is {carrier!r}, SER is undefined")
+        raise InputError(f"spectrum amplitude at mesh_hz={mesh_hz!r} is {carrier!r}, SER is undefined")
     k = np.arange(1, int(n_sidebands) + 1)
     sidebands = sum(at(mesh_hz - kk * shaft_hz) + at(mesh_hz + kk * shaft_hz) for kk in k)
     return float(sidebands / carrier)
@@ -320,7 +322,7 @@ def condition_indicators_from_average(
     """condition_indicators of a SynchronousAverage (which must know its ``teeth``), with the regular,
     difference and residual signals derived with ``shaft_orders`` low shaft orders removed."""
     if average.teeth is None:
-        raise ValueError("average.teeth is required for the condition indicators, got None")
+        raise InputError("average.teeth is required for the condition indicators, got None")
     return condition_indicators(
         average.average,
         average.difference(shaft_orders),

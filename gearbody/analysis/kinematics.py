@@ -16,6 +16,8 @@ import numpy as np
 
 from gearbody.analysis._validate import integer_at_least, positive_frequency
 
+from ..errors import InputError
+
 __all__ = [
     "Family",
     "GearMesh",
@@ -40,7 +42,7 @@ class Shaft:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
-            raise ValueError(f"Shaft name must be a non-empty string, got {self.name!r}")
+            raise InputError(f"Shaft name must be a non-empty string, got {self.name!r}")
         object.__setattr__(self, "rotation_hz", positive_frequency("Shaft rotation_hz", self.rotation_hz))
         if not self.symbol:
             object.__setattr__(self, "symbol", "f_" + "_".join(self.name.split()))
@@ -59,11 +61,11 @@ class GearMesh:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
-            raise ValueError(f"GearMesh name must be a non-empty string, got {self.name!r}")
+            raise InputError(f"GearMesh name must be a non-empty string, got {self.name!r}")
         object.__setattr__(self, "mesh_hz", positive_frequency("GearMesh mesh_hz", self.mesh_hz))
         shafts = tuple(self.shafts)
         if len(shafts) != 2 or shafts[0] == shafts[1]:
-            raise ValueError(f"GearMesh shafts must name two different shafts, got {self.shafts!r}")
+            raise InputError(f"GearMesh shafts must name two different shafts, got {self.shafts!r}")
         object.__setattr__(self, "shafts", shafts)
 
 
@@ -79,24 +81,24 @@ class KinematicSources:
         object.__setattr__(self, "shafts", shafts)
         object.__setattr__(self, "meshes", meshes)
         if not shafts:
-            raise ValueError("shafts must hold at least one Shaft, got none")
+            raise InputError("shafts must hold at least one Shaft, got none")
         names = [s.name for s in shafts]
         if len(set(names)) < len(names):
-            raise ValueError(f"shafts must have distinct names, got {names}")
+            raise InputError(f"shafts must have distinct names, got {names}")
         symbols = [s.symbol for s in shafts] + [m.name for m in meshes]
         if len(set(symbols)) < len(symbols):
-            raise ValueError(f"shaft symbols and mesh names must be distinct, got {symbols}")
+            raise InputError(f"shaft symbols and mesh names must be distinct, got {symbols}")
         for mesh in meshes:
             for shaft in mesh.shafts:
                 if shaft not in names:
-                    raise ValueError(f"mesh {mesh.name!r}: shaft {shaft!r} is not one of the shafts {names}")
+                    raise InputError(f"mesh {mesh.name!r}: shaft {shaft!r} is not one of the shafts {names}")
 
     def shaft(self, name: str) -> Shaft:
         """The shaft called ``name``."""
         for s in self.shafts:
             if s.name == name:
                 return s
-        raise ValueError(f"name must be one of {[s.name for s in self.shafts]}, got {name!r}")
+        raise InputError(f"name must be one of {[s.name for s in self.shafts]}, got {name!r}")
 
     @classmethod
     def gear_train(
@@ -115,12 +117,12 @@ class KinematicSources:
         f = positive_frequency("input_hz", input_hz)
         stages = [tuple(t) for t in teeth]
         if not stages:
-            raise ValueError("teeth must hold at least one (z_pinion, z_wheel) pair, got none")
+            raise InputError("teeth must hold at least one (z_pinion, z_wheel) pair, got none")
         for i, stage in enumerate(stages):
             if len(stage) != 2 or not all(
                 isinstance(z, (int, np.integer)) and not isinstance(z, bool) and z >= 1 for z in stage
             ):
-                raise ValueError(
+                raise InputError(
                     f"teeth[{i}] must be a pair of positive integers (z_pinion, z_wheel), got {stage}"
                 )
         if shaft_names is None:
@@ -128,7 +130,7 @@ class KinematicSources:
             shaft_names = defaults.get(len(stages), tuple(f"shaft{i + 1}" for i in range(len(stages) + 1)))
         shaft_names = tuple(shaft_names)
         if len(shaft_names) != len(stages) + 1:
-            raise ValueError(
+            raise InputError(
                 f"shaft_names must hold {len(stages) + 1} names (stages + 1), got {len(shaft_names)}"
             )
         shafts, meshes = [Shaft(shaft_names[0], f)], []
@@ -194,14 +196,14 @@ def kinematic_lines(
     Lines of different origin may coincide (29 f_pinion is f_z1 for a 29-tooth pinion); all are kept.
     """
     if not isinstance(sources, KinematicSources):
-        raise ValueError(f"sources must be a KinematicSources, got {type(sources).__name__}")
+        raise InputError(f"sources must be a KinematicSources, got {type(sources).__name__}")
     f_max_hz = positive_frequency("f_max_hz", f_max_hz)
     harmonics = integer_at_least("harmonics", harmonics, 1)
     if isinstance(sidebands, Mapping):
         names = [s.name for s in sources.shafts]
         for name in sidebands:
             if name not in names:
-                raise ValueError(f"sidebands names shaft {name!r}, not one of the shafts {names}")
+                raise InputError(f"sidebands names shaft {name!r}, not one of the shafts {names}")
         sideband_count = {n: integer_at_least(f"sidebands[{n!r}]", k, 0) for n, k in sidebands.items()}
         cross_sidebands = min(sideband_count.values(), default=0)
     else:

@@ -9,6 +9,8 @@ from collections.abc import Sequence
 from gearbody.analysis._validate import integer_at_least
 from gearbody.analysis.peaks import LabelledPeak
 
+from ..errors import InputError
+
 __all__ = ["UNEXPLAINED", "peaks_table", "peaks_to_rows"]
 
 
@@ -17,7 +19,7 @@ def checked_peaks(peaks: Sequence[LabelledPeak]) -> list[LabelledPeak]:
     peaks = list(peaks)
     for i, peak in enumerate(peaks):
         if not isinstance(peak, LabelledPeak):
-            raise ValueError(f"peaks[{i}] must be a LabelledPeak, got {type(peak).__name__}")
+            raise InputError(f"peaks[{i}] must be a LabelledPeak, got {type(peak).__name__}")
     return peaks
 
 

@@ -15,6 +15,8 @@ from gearbody.analysis._validate import integer_at_least, is_real, positive_freq
 from gearbody.analysis.kinematics import KinematicLine
 from gearbody.analysis.spectrum import Spectrum
 
+from ..errors import InputError
+
 __all__ = ["LABEL_SEPARATOR", "LabelledPeak", "label_peaks"]
 
 LABEL_SEPARATOR = "; "
@@ -79,18 +81,18 @@ def label_peaks(
         f_max_hz: ignore peaks above this frequency [Hz]; None for all up to Nyquist.
     """
     if not isinstance(spectrum, Spectrum):
-        raise ValueError(f"spectrum must be a Spectrum, got {type(spectrum).__name__}")
+        raise InputError(f"spectrum must be a Spectrum, got {type(spectrum).__name__}")
     f = np.asarray(spectrum.frequency_hz, dtype=float)
     a = np.asarray(spectrum.amplitude, dtype=float)
     if a.ndim != 1 or a.size < 3 or f.shape != a.shape:
-        raise ValueError(f"spectrum must hold at least 3 bins, got amplitude shape {a.shape}")
+        raise InputError(f"spectrum must hold at least 3 bins, got amplitude shape {a.shape}")
     df = spectrum.resolution_hz
     if tolerance_hz is None:
         tolerance_hz = 1.5 * df
     else:
         tolerance_hz = positive_frequency("tolerance_hz", tolerance_hz)
     if not (is_real(min_prominence_db) and math.isfinite(min_prominence_db) and min_prominence_db >= 0):
-        raise ValueError(f"min_prominence_db must be a finite number >= 0 [dB], got {min_prominence_db!r}")
+        raise InputError(f"min_prominence_db must be a finite number >= 0 [dB], got {min_prominence_db!r}")
     if max_peaks is not None:
         max_peaks = integer_at_least("max_peaks", max_peaks, 1)
     floor_bins = integer_at_least("floor_bins", floor_bins, 1)
@@ -99,7 +101,7 @@ def label_peaks(
     lines = list(lines)
     for i, line in enumerate(lines):
         if not isinstance(line, KinematicLine):
-            raise ValueError(f"lines[{i}] must be a KinematicLine, got {type(line).__name__}")
+            raise InputError(f"lines[{i}] must be a KinematicLine, got {type(line).__name__}")
 
     index, prominence_db, keep = _prominent_peaks(f, a, min_prominence_db, max_peaks, floor_bins, f_max_hz)
     return _labelled(f, a, index, prominence_db, keep, lines, tolerance_hz)

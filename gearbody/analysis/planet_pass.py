@@ -34,6 +34,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from gearbody.analysis._validate import integer_at_least, is_real, positive_frequency
 
+from ..errors import InputError
+
 __all__ = [
     "Excitation",
     "HannPassWindow",
@@ -65,7 +67,7 @@ class HannPassWindow:
     def __post_init__(self) -> None:
         w = self.width_rad
         if not (is_real(w) and math.isfinite(w) and 0 < w <= 2.0 * math.pi * (1 + 1e-12)):
-            raise ValueError(f"width_rad must be in (0, 2 pi] = (0, {2 * math.pi:.6f}] rad, got {w!r}")
+            raise InputError(f"width_rad must be in (0, 2 pi] = (0, {2 * math.pi:.6f}] rad, got {w!r}")
         object.__setattr__(self, "width_rad", float(min(w, 2.0 * math.pi)))
 
     def __call__(self, angle_rad: ArrayLike) -> NDArray[np.float64]:
@@ -90,11 +92,11 @@ def _finite_array(name: str, value: ArrayLike, ndim: int) -> NDArray[np.float64]
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a numeric array, got {type(value).__name__}") from None
+        raise InputError(f"{name} must be a numeric array, got {type(value).__name__}") from None
     if array.ndim != ndim:
-        raise ValueError(f"{name} must be {ndim}-D, got shape {array.shape}")
+        raise InputError(f"{name} must be {ndim}-D, got shape {array.shape}")
     if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite, got {int(np.sum(~np.isfinite(array)))} non-finite values")
+        raise InputError(f"{name} must be finite, got {int(np.sum(~np.isfinite(array)))} non-finite values")
     return array
 
 
@@ -123,30 +125,30 @@ def ring_sensor_signal(
     """
     t = _finite_array("time_s", time_s, 1)
     if t.size < 2 or np.any(np.diff(t) <= 0):
-        raise ValueError(f"time_s must hold at least 2 increasing samples, got {t.size} samples")
+        raise InputError(f"time_s must hold at least 2 increasing samples, got {t.size} samples")
     psi = _finite_array("planet_angles_rad", planet_angles_rad, 2)
     force = _finite_array("planet_mesh_forces_N", planet_mesh_forces_N, 2)
     if psi.shape[1] != t.size or psi.shape[0] < 1:
-        raise ValueError(
+        raise InputError(
             f"planet_angles_rad must have shape (n_planets, {t.size}) for {t.size} time samples, "
             f"got {psi.shape}"
         )
     if force.shape != psi.shape:
-        raise ValueError(
+        raise InputError(
             f"planet_mesh_forces_N must have the shape of planet_angles_rad {psi.shape}, got {force.shape}"
         )
     if not (is_real(sensor_angle_rad) and math.isfinite(sensor_angle_rad)):
-        raise ValueError(f"sensor_angle_rad must be a finite angle [rad], got {sensor_angle_rad!r}")
+        raise InputError(f"sensor_angle_rad must be a finite angle [rad], got {sensor_angle_rad!r}")
     if not callable(window):
-        raise ValueError(f"window must be callable (e.g. HannPassWindow), got {type(window).__name__}")
+        raise InputError(f"window must be callable (e.g. HannPassWindow), got {type(window).__name__}")
     relative = wrap_angle_rad(psi - float(sensor_angle_rad))
     weights = np.asarray(window(relative), dtype=float)
     if weights.shape != psi.shape or not np.all(np.isfinite(weights)):
-        raise ValueError(f"window must return finite weights of shape {psi.shape}, got shape {weights.shape}")
+        raise InputError(f"window must return finite weights of shape {psi.shape}, got shape {weights.shape}")
     if force_direction_offset_rad is not None:
         delta = force_direction_offset_rad
         if not (is_real(delta) and math.isfinite(delta)):
-            raise ValueError(
+            raise InputError(
                 f"force_direction_offset_rad must be a finite angle [rad] or None, got {delta!r}"
             )
         weights = weights * np.cos(relative + float(delta))
@@ -197,7 +199,7 @@ def surviving_lines(
     if isinstance(harmonics, Sequence) and not isinstance(harmonics, str):
         ks = [integer_at_least(f"harmonics[{i}]", k, 1) for i, k in enumerate(harmonics)]
         if not ks:
-            raise ValueError("harmonics must hold at least one harmonic number >= 1, got none")
+            raise InputError("harmonics must hold at least one harmonic number >= 1, got none")
     else:
         ks = list(range(1, integer_at_least("harmonics", harmonics, 1) + 1))
     out = []

@@ -47,6 +47,8 @@ from typing import Literal
 from gearbody.analysis._validate import integer_at_least, is_real, positive_frequency
 from gearbody.analysis.kinematics import KinematicLine, _combination_label
 
+from ..errors import InputError
+
 __all__ = [
     "CANCELLED_MARK",
     "SYMBOLS",
@@ -90,7 +92,7 @@ class PlanetaryLine(KinematicLine):
 
 def _signed_speed(name: str, value: float) -> float:
     if not (is_real(value) and math.isfinite(value)):
-        raise ValueError(f"{name} must be a finite signed speed [Hz], got {value!r}")
+        raise InputError(f"{name} must be a finite signed speed [Hz], got {value!r}")
     return float(value)
 
 
@@ -124,7 +126,7 @@ class PlanetarySources:
         z_p = integer_at_least("z_planet", self.z_planet, 3)
         z_r = integer_at_least("z_ring", self.z_ring, 3)
         if z_r <= max(z_s, z_p):
-            raise ValueError(
+            raise InputError(
                 f"z_ring must exceed z_sun = {z_s} and z_planet = {z_p} (an internal gear round the "
                 f"planets), got {z_r}"
             )
@@ -132,11 +134,11 @@ class PlanetarySources:
         for name in ("carrier_hz", "sun_hz", "ring_hz", "planet_hz"):
             object.__setattr__(self, name, _signed_speed(name, getattr(self, name)))
         if not (is_real(self.rtol) and 0 < self.rtol < 1):
-            raise ValueError(f"rtol must be a number in (0, 1), got {self.rtol!r}")
+            raise InputError(f"rtol must be a number in (0, 1), got {self.rtol!r}")
         f_c, f_r = self.carrier_hz, self.ring_hz
         mesh_hz = z_r * abs(f_r - f_c)
         if mesh_hz == 0:
-            raise ValueError(
+            raise InputError(
                 f"carrier_hz = {f_c!r} equals ring_hz = {f_r!r}: the stage turns as one block and nothing "
                 "meshes; the carrier must turn relative to the ring"
             )
@@ -147,7 +149,7 @@ class PlanetarySources:
             ("planet_hz", self.planet_hz, planet_expected, z_p),
         ):
             if abs(value - expected) * teeth > self.rtol * mesh_hz:
-                raise ValueError(
+                raise InputError(
                     f"{name} must be {expected:.9g} Hz by the Willis equation for carrier_hz = {f_c!r}, "
                     f"ring_hz = {f_r!r} and teeth {z_s}/{z_p}/{z_r} (sun/planet/ring), got {value!r} "
                     f"(allowed mismatch {self.rtol:g} of the mesh frequency)"
@@ -200,7 +202,7 @@ class PlanetarySources:
             "f_rf": self.ring_fault_hz,
         }
         if symbol not in values:
-            raise ValueError(f"symbol must be one of {sorted(values)}, got {symbol!r}")
+            raise InputError(f"symbol must be one of {sorted(values)}, got {symbol!r}")
         return values[symbol]
 
 
@@ -227,7 +229,7 @@ def planetary_lines(
     it survives the sum over equally spaced planets (:attr:`PlanetaryLine.survives_equal_spacing`).
     """
     if not isinstance(sources, PlanetarySources):
-        raise ValueError(f"sources must be a PlanetarySources, got {type(sources).__name__}")
+        raise InputError(f"sources must be a PlanetarySources, got {type(sources).__name__}")
     f_max_hz = positive_frequency("f_max_hz", f_max_hz)
     harmonics = integer_at_least("harmonics", harmonics, 1)
     n = sources.n_planets
@@ -283,7 +285,7 @@ def mark_cancelled(lines: Sequence[PlanetaryLine]) -> list[PlanetaryLine]:
     out = []
     for i, line in enumerate(lines):
         if not isinstance(line, PlanetaryLine):
-            raise ValueError(f"lines[{i}] must be a PlanetaryLine, got {type(line).__name__}")
+            raise InputError(f"lines[{i}] must be a PlanetaryLine, got {type(line).__name__}")
         cancelled = line.survives_equal_spacing is False
         out.append(replace(line, label=f"{line.label} {CANCELLED_MARK}") if cancelled else line)
     return out

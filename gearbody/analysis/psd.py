@@ -14,6 +14,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from gearbody.analysis._validate import is_real, positive_frequency
 
+from ..errors import InputError
+
 __all__ = ["Psd", "power_spectral_density"]
 
 
@@ -50,9 +52,9 @@ class Psd:
 def _checked_signal(signal: ArrayLike, sample_rate_hz: float) -> NDArray[np.float64]:
     x = np.asarray(signal, dtype=float)
     if x.ndim != 1 or x.size < 2:
-        raise ValueError(f"signal must be 1-D with at least 2 samples, got shape {x.shape}")
+        raise InputError(f"signal must be 1-D with at least 2 samples, got shape {x.shape}")
     if not np.all(np.isfinite(x)):
-        raise ValueError("signal contains non-finite samples")
+        raise InputError("signal contains non-finite samples")
     positive_frequency("sample_rate_hz", sample_rate_hz)
     return x
 
@@ -93,17 +95,17 @@ def power_spectral_density(
         nperseg = max(2, n // 4)
     else:
         if not (is_real(segment_s) and math.isfinite(segment_s) and segment_s > 0):
-            raise ValueError(f"segment_s must be a positive duration [s], got {segment_s!r}")
+            raise InputError(f"segment_s must be a positive duration [s], got {segment_s!r}")
         nperseg = int(round(segment_s * sample_rate_hz))
         if not 2 <= nperseg <= n:
-            raise ValueError(
+            raise InputError(
                 f"segment_s must lie in [{2 / sample_rate_hz:.6g}, {n / sample_rate_hz:.6g}] s "
                 f"(2 samples .. the whole signal), got {segment_s!r} s = {nperseg} samples"
             )
     if detrend is True:
         detrend = "constant"
     if not (detrend is False or detrend in ("constant", "linear")):
-        raise ValueError(f"detrend must be a bool, 'constant' or 'linear', got {detrend!r}")
+        raise InputError(f"detrend must be a bool, 'constant' or 'linear', got {detrend!r}")
     noverlap = nperseg // 2
     from scipy.signal import welch  # ~0.4 s to import: on use only
 

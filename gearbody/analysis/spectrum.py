@@ -11,6 +11,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import InputError
+
 __all__ = [
     "Peak",
     "SidebandLine",
@@ -88,16 +90,16 @@ def amplitude_spectrum(
     """
     x = np.asarray(signal, dtype=float)
     if x.ndim != 1 or x.size < 2:
-        raise ValueError(f"signal must be 1-D with at least 2 samples, got shape {x.shape}")
+        raise InputError(f"signal must be 1-D with at least 2 samples, got shape {x.shape}")
     if not np.all(np.isfinite(x)):
-        raise ValueError("signal contains non-finite samples")
+        raise InputError("signal contains non-finite samples")
     if not sample_rate_hz > 0:
-        raise ValueError(f"sample_rate_hz must be positive, got {sample_rate_hz!r}")
+        raise InputError(f"sample_rate_hz must be positive, got {sample_rate_hz!r}")
     if detrend is True:
         detrend = "constant"
     if detrend:
         if detrend not in ("constant", "linear"):
-            raise ValueError(f"detrend must be a bool, 'constant' or 'linear', got {detrend!r}")
+            raise InputError(f"detrend must be a bool, 'constant' or 'linear', got {detrend!r}")
         if detrend == "constant":  # what scipy.signal.detrend does, without its ~0.6 s import
             x = x - np.mean(x, axis=-1, keepdims=True)
         else:
@@ -122,7 +124,7 @@ def amplitude_spectrum(
 def mesh_harmonics(mesh_frequency_hz: float, fmax_hz: float) -> NDArray[np.float64]:
     """Mesh frequency harmonics k * f_z [Hz] for k = 1, 2, ... with k * f_z <= fmax_hz."""
     if not mesh_frequency_hz > 0:
-        raise ValueError(f"mesh_frequency_hz must be positive, got {mesh_frequency_hz!r}")
+        raise InputError(f"mesh_frequency_hz must be positive, got {mesh_frequency_hz!r}")
     count = int(np.floor(fmax_hz / mesh_frequency_hz * (1.0 + 1e-12))) if fmax_hz > 0 else 0
     return mesh_frequency_hz * np.arange(1, count + 1, dtype=float)
 
@@ -141,7 +143,7 @@ def peak_near(spectrum: Spectrum, f_hz: float, tol_hz: float) -> Peak:
     """Largest bin with |frequency - f_hz| <= tol_hz; raises ValueError if no bin lies in that band."""
     inside = np.abs(spectrum.frequency_hz - f_hz) <= tol_hz
     if not np.any(inside):
-        raise ValueError(
+        raise InputError(
             f"no spectrum bin within {tol_hz} Hz of {f_hz} Hz (resolution {spectrum.resolution_hz:.4g} Hz)"
         )
     candidates = np.flatnonzero(inside)
@@ -194,7 +196,7 @@ def sideband_lines(
     amplitude over +- f_m / 2 around it, so a line is visible when ``prominence_db`` is well above 0.
     """
     if not (carrier_hz > 0 and modulation_hz > 0):
-        raise ValueError(f"carrier_hz and modulation_hz must be positive, got {carrier_hz}, {modulation_hz}")
+        raise InputError(f"carrier_hz and modulation_hz must be positive, got {carrier_hz}, {modulation_hz}")
     f, a = spectrum.frequency_hz, spectrum.amplitude
     df = spectrum.resolution_hz
     out = []

@@ -33,6 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import InputError
+
 __all__ = [
     "MAX_DEFAULT_POINTS_PER_REV",
     "MIN_POINTS_PER_REV",
@@ -57,10 +59,10 @@ _REV_TOL = 1e-9
 def _as_1d(name: str, values: ArrayLike) -> NDArray[np.float64]:
     array = np.asarray(values, dtype=float)
     if array.ndim != 1:
-        raise ValueError(f"{name} must be 1-D, got shape {array.shape}")
+        raise InputError(f"{name} must be 1-D, got shape {array.shape}")
     if not np.all(np.isfinite(array)):
         first = int(np.flatnonzero(~np.isfinite(array))[0])
-        raise ValueError(f"{name} must be finite, sample {first} is {array[first]!r}")
+        raise InputError(f"{name} must be finite, sample {first} is {array[first]!r}")
     return array
 
 
@@ -68,7 +70,7 @@ def _check_teeth(teeth: int | None) -> int | None:
     if teeth is None:
         return None
     if isinstance(teeth, bool) or int(teeth) != teeth or teeth < 1:
-        raise ValueError(f"teeth must be a positive integer or None, got {teeth!r}")
+        raise InputError(f"teeth must be a positive integer or None, got {teeth!r}")
     return int(teeth)
 
 
@@ -79,13 +81,13 @@ def _signal_and_angle(
     y = _as_1d("signal", signal)
     angle = _as_1d("shaft_angle_rad", shaft_angle_rad)
     if y.size != angle.size:
-        raise ValueError(f"signal and shaft_angle_rad must have equal lengths, got {y.size} and {angle.size}")
+        raise InputError(f"signal and shaft_angle_rad must have equal lengths, got {y.size} and {angle.size}")
     if angle.size < 2:
-        raise ValueError(f"shaft_angle_rad must have at least 2 samples, got {angle.size}")
+        raise InputError(f"shaft_angle_rad must have at least 2 samples, got {angle.size}")
     step = np.diff(angle)
     if np.any(step <= 0.0):
         i = int(np.flatnonzero(step <= 0.0)[0])
-        raise ValueError(
+        raise InputError(
             "shaft_angle_rad must be strictly increasing (unwrapped, rotation in the positive sense): "
             f"sample {i + 1} is {angle[i + 1]!r} rad after {angle[i]!r} rad at sample {i}"
         )
@@ -93,7 +95,7 @@ def _signal_and_angle(
     start_rad = _TWO_PI * first_rev + 0.0  # + 0.0 turns -0.0 into 0.0
     n_revs = int(np.floor((angle[-1] - start_rad) / _TWO_PI + _REV_TOL))
     if n_revs < 1:
-        raise ValueError(
+        raise InputError(
             "shaft_angle_rad must cover at least 1 complete revolution from the first whole revolution "
             f"({start_rad:.6g} rad), got {angle[0]:.6g} .. {angle[-1]:.6g} rad"
         )
@@ -102,9 +104,9 @@ def _signal_and_angle(
 
 def _check_points_per_rev(points_per_rev: int) -> int:
     if isinstance(points_per_rev, bool) or int(points_per_rev) != points_per_rev:
-        raise ValueError(f"points_per_rev must be an integer, got {points_per_rev!r}")
+        raise InputError(f"points_per_rev must be an integer, got {points_per_rev!r}")
     if points_per_rev < MIN_POINTS_PER_REV:
-        raise ValueError(f"points_per_rev must be >= {MIN_POINTS_PER_REV}, got {points_per_rev!r}")
+        raise InputError(f"points_per_rev must be >= {MIN_POINTS_PER_REV}, got {points_per_rev!r}")
     return int(points_per_rev)
 
 
@@ -162,7 +164,7 @@ def default_points_per_rev(signal_length: int, n_revs: float, teeth: int | None 
     """
     teeth = _check_teeth(teeth)
     if not n_revs > 0:
-        raise ValueError(f"n_revs must be positive, got {n_revs!r}")
+        raise InputError(f"n_revs must be positive, got {n_revs!r}")
     per_rev = 4.0 * signal_length / n_revs
     points = min(1 << max(int(np.ceil(np.log2(max(per_rev, 1.0)))), 0), MAX_DEFAULT_POINTS_PER_REV)
     if teeth is not None:
@@ -192,12 +194,12 @@ class SynchronousAverage:
         teeth = _check_teeth(self.teeth)
         object.__setattr__(self, "teeth", teeth)
         if self.angle_rad.shape != self.average.shape or self.average.ndim != 1:
-            raise ValueError(
+            raise InputError(
                 f"angle_rad and average must be 1-D of equal shape, got {self.angle_rad.shape} and "
                 f"{self.average.shape}"
             )
         if teeth is not None and self.points_per_rev < 2 * (teeth + 1):
-            raise ValueError(
+            raise InputError(
                 f"points_per_rev must be >= 2 (teeth + 1) = {2 * (teeth + 1)} to resolve the mesh order "
                 f"and its upper sideband, got {self.points_per_rev} (teeth={teeth})"
             )
@@ -225,9 +227,9 @@ class SynchronousAverage:
     def _masks(self, shaft_orders: int) -> tuple[NDArray[np.bool_], NDArray[np.bool_], NDArray[np.bool_]]:
         """Boolean masks over the rfft orders: mesh orders, their first sidebands, low shaft orders."""
         if self.teeth is None:
-            raise ValueError("teeth is required for the regular, difference and residual signals, got None")
+            raise InputError("teeth is required for the regular, difference and residual signals, got None")
         if isinstance(shaft_orders, bool) or int(shaft_orders) != shaft_orders or shaft_orders < 0:
-            raise ValueError(f"shaft_orders must be a non-negative integer, got {shaft_orders!r}")
+            raise InputError(f"shaft_orders must be a non-negative integer, got {shaft_orders!r}")
         order = np.arange(self.points_per_rev // 2 + 1)
         z = int(self.teeth)
         mesh = (order >= z) & (order % z == 0)

@@ -19,6 +19,7 @@ import numpy as np
 
 from gearbody.model import Scenario, load_scenario, scenario_to_dict
 
+from ..errors import InputError
 from .executors import run_jobs
 from .tasks import SPEED_VALUES, speed_case
 
@@ -95,9 +96,9 @@ def kd_speed_sweep(
     """
     fractions = [float(f) for f in speed_fractions]
     if not fractions or min(fractions) <= 0:
-        raise ValueError(f"speed_fractions must be non-empty and > 0, got {fractions}")
+        raise InputError(f"speed_fractions must be non-empty and > 0, got {fractions}")
     if settle_s < 0 or record_s <= 0:
-        raise ValueError(f"settle_s must be >= 0 and record_s > 0, got {settle_s}, {record_s}")
+        raise InputError(f"settle_s must be >= 0 and record_s > 0, got {settle_s}, {record_s}")
     data = scenario_to_dict(scenario)
     overrides = [steady_overrides(f, settle_s + record_s) for f in fractions]
     for ov in overrides:  # every case valid before anything runs (a ScenarioError is raised, not recorded)
