@@ -35,6 +35,8 @@ Morris, Sobol) and calibration of a scene's keys to measured features (:func:`ca
 Public: the names of ``__all__``, importable from here (``from gearbody.studies import ...``).
 """
 
+from ..plotting.campbell import plot_campbell
+from ..plotting.kd_speed import plot_kd_against_speed
 from .calibration import CalibrationResult, Parameter, Target
 from .parse import (
     MAX_CASES,
@@ -66,6 +68,8 @@ __all__ = [
     "StudyResult",
     "SweepSpecError",
     "kd_speed_sweep",
+    "plot_campbell",
+    "plot_kd_against_speed",
     "parse_distribution",
     "parse_random",
     "parse_vary",
