@@ -28,7 +28,6 @@ MODULE_REASON_LINES = 10
 # or no longer exists), so the list cannot go stale.
 PENDING = {
     # modules
-    "result.py",
     "assembly/stiff_modes.py",
     "model/scenario.py",
     "model/planetary.py",

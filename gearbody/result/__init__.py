@@ -2,13 +2,13 @@
 
 Signals carry their unit in their name (``mesh_force_N``, ``pinion_speed_rad_s``). The metadata holds
 the resolved scenario, the seed, gearbody and Exudyn versions, the output rate and solver statistics,
-so a saved result says where it came from.
+so a saved result says where it came from. The package: :class:`Result` here, its labelled spectrum in
+:mod:`gearbody.result.spectrum`, its summary.json values in :mod:`gearbody.result.summary`.
 """
 
 from __future__ import annotations
 
 import json
-import math
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,9 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from .errors import SignalError, StageError
-from .signals import SIGNAL_UNITS, gear_names, stage_signal
-from .stage_meta import PLANET_MESHES, PlanetaryTeeth, StageMeta, stage_meta
+from ..errors import SignalError, StageError
+from ..signals import SIGNAL_UNITS, gear_names, stage_signal
+from ..stage_meta import PLANET_MESHES, PlanetaryTeeth, StageMeta, stage_meta
+from .spectrum import LabelledSpectrum
 
 FINAL_FRACTION = 0.25
 """Share of the run, at its end, over which 'final' values are taken (the steady period)."""
@@ -179,98 +180,14 @@ class Result:
         planetary stage's ring sensor is read as in its run plot and report: order-tracked over the whole
         carrier revolutions of the run's steady part (``fraction`` does not apply), the lines the phasing
         rule cancels marked "(cancelled)" (docs/planetary-lines.md)."""
-        from .analysis import amplitude_spectrum, gear_train_lines, label_peaks
+        from .spectrum import labelled_spectrum
 
-        name = signal or self.vibration_signal_name
-        for k, st in enumerate(self.stages):  # a stage's own sensor (a planetary stage's ring sensor)
-            own = st.sensor_spectrum(self, k, name, min_prominence_db, max_peaks)
-            if own is not None:
-                spectrum, peaks, f_max = own
-                return LabelledSpectrum(signal=name, spectrum=spectrum, peaks=peaks, f_max_hz=f_max)
-        win = self.final_window(fraction)
-        spec = amplitude_spectrum(self[name][win], self.sample_rate_hz, window="hann")
-        peaks = []
-        f_max = self.sample_rate_hz / 2
-        if not self._gear_train:
-            f_top = max(st.mesh_frequency_hz(self, k, fraction) for k, st in enumerate(self.stages))
-            if f_top > 0:
-                f_max = min(f_max, (harmonics + 0.5) * f_top)
-                lines = self._compound_lines(fraction, f_max, harmonics, sidebands)
-                peaks = label_peaks(
-                    spec,
-                    lines,
-                    tolerance_hz=1.5 * spec.resolution_hz,
-                    min_prominence_db=min_prominence_db,
-                    max_peaks=max_peaks,
-                    f_max_hz=f_max,
-                )
-            return LabelledSpectrum(signal=name, spectrum=spec, peaks=peaks, f_max_hz=f_max)
-        f_mesh = self.mesh_frequency_hz(0, fraction)
-        if f_mesh > 0:
-            f_max = min(f_max, (harmonics + 0.5) * f_mesh)
-            teeth = [st.gear_pair() for st in self.stages]
-            lines = gear_train_lines(
-                f_mesh / teeth[0][0], teeth, f_max, harmonics=harmonics, sidebands=sidebands
-            )
-            peaks = label_peaks(
-                spec,
-                lines,
-                tolerance_hz=1.5 * spec.resolution_hz,
-                min_prominence_db=min_prominence_db,
-                max_peaks=max_peaks,
-                f_max_hz=f_max,
-            )
-        return LabelledSpectrum(signal=name, spectrum=spec, peaks=peaks, f_max_hz=f_max)
+        return labelled_spectrum(self, signal, fraction, harmonics, sidebands, min_prominence_db, max_peaks)
 
     @property
     def _gear_train(self) -> bool:
         """True when every stage is a gear pair of one train (its spectrum is labelled as a gear train)."""
         return all(st.gear_pair() is not None for st in self.stages)
-
-    def _compound_lines(self, fraction: float, f_max: float, harmonics: int, sidebands: int) -> list:
-        """Kinematic lines of a drive whose stages are not all gear pairs: each run of consecutive gear
-        pairs as a gear train (shafts named after its pinions and wheels, meshes f_z<stage>), each other
-        stage's own lines (a planetary stage's, docs/planetary-lines.md; labelled with their stage when
-        the drive has several such stages)."""
-        from dataclasses import replace
-
-        from .analysis import GearMesh, KinematicSources, Shaft, kinematic_lines
-
-        lines: list = []
-        shafts: list = []
-        meshes: list = []
-
-        def flush() -> None:
-            if shafts:
-                sources = KinematicSources(tuple(shafts), tuple(meshes))
-                lines.extend(
-                    kinematic_lines(sources, f_max, harmonics=harmonics, sidebands=sidebands, shaft_orders=30)
-                )
-                shafts.clear()
-                meshes.clear()
-
-        several = sum(st.gear_pair() is None for st in self.stages) > 1
-        for k, st in enumerate(self.stages):
-            pair = st.gear_pair()
-            if pair is None:
-                flush()
-                lines.extend(
-                    replace(line, label=f"{line.label} (stage {k + 1})") if several else line
-                    for line in st.stage_lines(self, k, f_max, harmonics)
-                )
-                continue
-            z1, z2 = pair
-            f_mesh = st.mesh_frequency_hz(self, k, fraction)
-            if f_mesh <= 0:
-                flush()
-                continue
-            tag = "" if k == 0 else f" {k + 1}"
-            if not shafts:
-                shafts.append(Shaft(f"pinion{tag}", f_mesh / z1))
-            shafts.append(Shaft(f"wheel{tag}", f_mesh / z2))
-            meshes.append(GearMesh(f"f_z{k + 1}", f_mesh, (shafts[-2].name, shafts[-1].name)))
-        flush()
-        return sorted(lines, key=lambda line: line.frequency_hz)
 
     @property
     def vibration_signal_name(self) -> str:
@@ -294,129 +211,28 @@ class Result:
         final quarter (the steady, rated-load period of the four-period runs), separation, mesh frequency,
         speed, solver statistics and bearing forces; whole-run values say so by having no '_final'. Last,
         ``sources``: where the scene's parameter values come from (``meta.sources``)."""
-        from .analysis import separation_stats
+        from .summary import run_summary
 
-        sources = {"sources": list(self.meta.get("sources") or [])}
-        if not self._gear_train:
-            return {**self._compound_summary(), **self._direction_summary(), **sources}
-        win = self.final_window()
-        sep = separation_stats(self.mesh_force, self.time_s, kd=self.kd)
-        speed = (
-            self["pinion_speed_rad_s"]
-            if "pinion_speed_rad_s" in self
-            else 2 * math.pi * self["mesh_frequency_hz"] / self.meta["pinion_teeth"]
-        )
-        stats = self.meta.get("solver_statistics", {})
-        return {
-            "scene": self.meta.get("scene"),
-            "kd_max": float(np.max(self.kd)),
-            "kd_min": float(np.min(self.kd)),
-            "kd_max_final": float(np.max(self.kd[win])),
-            "kd_mean_final": float(np.mean(self.kd[win])),
-            "kd_above_2": bool(np.max(self.kd) > 2.0),
-            "separation_fraction": float(sep.separated_fraction),
-            "contact_losses": int(sep.contact_losses),
-            "mesh_frequency_hz": float(np.mean(self["mesh_frequency_hz"][win])),
-            "mean_speed_rad_s": float(np.mean(speed[win])),
-            "rated_mesh_force_N": float(self.meta.get("rated_mesh_force_N", float("nan"))),
-            "simulated_time_s": float(self.time_s[-1] - self.time_s[0]),
-            "wall_time_s": float(stats.get("wall_time_s", float("nan"))),
-            "wall_s_per_simulated_s": float(stats.get("wall_time_s", float("nan")))
-            / max(float(self.time_s[-1] - self.time_s[0]), 1e-300),
-            "solver_steps": int(stats.get("steps", 0)),
-            "solver_rejected_steps": int(stats.get("rejected_steps", 0)),
-            "seed": self.meta.get("seed"),
-            **{
-                f"{gear}_bearing_force_{axis}_max_N": float(
-                    np.max(np.abs(self[f"{gear}_bearing_force_{axis}_N"]))
-                )
-                for gear in self.bearing_gears
-                for axis in "xy"
-            },
-            **{
-                f"{gear}_housing_accel_{axis}_rms_final_m_s2": float(
-                    np.std(self[f"{gear}_housing_accel_{axis}_m_s2"][win])
-                )
-                for gear in self.bearing_gears
-                for axis in "xy"
-            },
-            **self._direction_summary(),
-            **sources,
-        }
+        return run_summary(self)
 
     def rotation_directions(self):
         """Which way each rotation turned (:class:`gearbody.analysis.RotationDirections`): its smallest
         speed in its driven direction and, if it turned backwards, since when (an overrunning load)."""
-        from .analysis import rotation_directions
+        from ..analysis import rotation_directions
 
         nominal = self.meta.get("nominal_speeds_rad_s") or {}
         speeds = {name: self[f"{name}_speed_rad_s"] for name in nominal if f"{name}_speed_rad_s" in self}
         return rotation_directions(self.time_s, speeds, nominal)
-
-    def _direction_summary(self) -> dict[str, Any]:
-        """summary() keys of :meth:`rotation_directions`: ``<rotation>_driven_speed_min_rad_s`` and
-        ``turned_backwards`` with the first rotation and time (NaN and '' when it never did)."""
-        d = self.rotation_directions()
-        first = d.first
-        return {
-            **{f"{name}_driven_speed_min_rad_s": v for name, v in d.driven_speed_min_rad_s.items()},
-            "turned_backwards": d.turned_backwards,
-            "turned_backwards_first": first[0] if first else "",
-            "turned_backwards_at_s": first[1] if first else float("nan"),
-        }
 
     @property
     def planetary_stages(self) -> list[int]:
         """Indices of the planetary stages (0-based)."""
         return [k for k, st in enumerate(self.stages) if st.kind == "planetary"]
 
-    def _compound_summary(self) -> dict[str, Any]:
-        """summary() of a drive whose stages are not all gear pairs (planetary stages, say): the first
-        stage's K_d over all its meshes (every planet's sun and ring mesh: the keys studies and
-        calibrations read by default), then each stage's own keys (a planetary stage: per mesh type the
-        planets' K_d, load sharing, separations; a later parallel stage: its K_d); speed and solver
-        statistics."""
-        from .analysis import separation_stats
-
-        win = self.final_window()
-        stats = self.meta.get("solver_statistics", {})
-        t = float(self.time_s[-1] - self.time_s[0])
-        out: dict[str, Any] = {"scene": self.meta.get("scene")}
-        first = self.stages[0].mesh_signals(0)
-        if first:
-            kd = np.array([self[kd_name] for kd_name, _ in first])
-            seps = [separation_stats(self[force], self.time_s, kd=self[kd_name]) for kd_name, force in first]
-            out.update(
-                {
-                    "kd_max": float(kd.max()),
-                    "kd_min": float(kd.min()),
-                    "kd_max_final": float(kd[:, win].max()),
-                    "kd_mean_final": float(kd[:, win].mean()),
-                    "kd_above_2": bool(kd.max() > 2.0),
-                    "separation_fraction": float(max(s.separated_fraction for s in seps)),
-                    "contact_losses": int(sum(s.contact_losses for s in seps)),
-                    "mesh_frequency_hz": float(np.mean(self["mesh_frequency_hz"][win])),
-                }
-            )
-        for k, st in enumerate(self.stages):
-            out.update(st.summary(self, k, win))
-        out.update(
-            {
-                "mean_speed_rad_s": float(np.mean(self["motor_speed_rad_s"][win])),
-                "simulated_time_s": t,
-                "wall_time_s": float(stats.get("wall_time_s", float("nan"))),
-                "wall_s_per_simulated_s": float(stats.get("wall_time_s", float("nan"))) / max(t, 1e-300),
-                "solver_steps": int(stats.get("steps", 0)),
-                "solver_rejected_steps": int(stats.get("rejected_steps", 0)),
-                "seed": self.meta.get("seed"),
-            }
-        )
-        return out
-
     def period_boundaries_s(self) -> tuple[float, ...]:
         """The run's operating periods: its start, every breakpoint of the speed and load profiles inside
         the run, its end [s] (the four-period runs: 0, run-up end, load start, load rated, t_end)."""
-        from .analysis.features import operating_periods_s
+        from ..analysis.features import operating_periods_s
 
         operation = self.meta.get("scenario", {}).get("operation", {})
         times = [
@@ -429,7 +245,7 @@ class Result:
     def record(self, natural_frequencies_hz=()):
         """The run as an :class:`~gearbody.analysis.features.Record` for features (``natural_frequencies_hz``:
         from ``gearbody.engine.natural_frequencies`` or measured, for the natural-frequency features)."""
-        from .analysis.features import Record
+        from ..analysis.features import Record
 
         if self.stages:
             teeth = self.stages[0].gear_pair() or (None, None)
@@ -447,7 +263,7 @@ class Result:
     def features(self, specs, natural_frequencies_hz=()) -> dict[str, float]:
         """``{spec: value}`` of the named features (gearbody.analysis.features), e.g.
         ``result.features(["kd_max:period=4", "line_amplitude:signal=pinion_accel_rad_s2,mesh=1"])``."""
-        from .analysis.features import evaluate_features
+        from ..analysis.features import evaluate_features
 
         return evaluate_features(specs, self.record(natural_frequencies_hz))
 
@@ -456,12 +272,12 @@ class Result:
         mesh period, the spectrum of the vibration signal, bearing forces (gearbody.plotting.run); per
         planetary stage its planet meshes' K_d, load sharing and ring-sensor spectrum
         (gearbody.plotting.planetary)."""
-        from .plotting.run import write_plots
+        from ..plotting.run import write_plots
 
         Path(out_dir).mkdir(parents=True, exist_ok=True)
         paths = write_plots(self, out_dir)
         if self.planetary_stages:
-            from .plotting.planetary import write_planetary_plots
+            from ..plotting.planetary import write_planetary_plots
 
             paths += write_planetary_plots(self, out_dir)
         return paths
@@ -492,36 +308,6 @@ class Result:
             meta = json.loads(str(data["meta_json"])) if "meta_json" in data else {}
             signals = {k: data[k] for k in data.files if k not in ("time", "time_s", "meta_json")}
             return cls(time_s=data["time_s"], signals=signals, meta=meta)
-
-
-@dataclass(frozen=True)
-class LabelledSpectrum:
-    """An amplitude spectrum with its prominent peaks labelled by the drive's kinematic lines."""
-
-    signal: str
-    spectrum: Any  # gearbody.analysis.Spectrum
-    peaks: list
-    f_max_hz: float
-
-    def table(self, max_rows: int | None = 20) -> str:
-        """The peaks as a text table (frequency, amplitude, labels)."""
-        from .analysis import peaks_table
-
-        return peaks_table(self.peaks, max_rows=max_rows)
-
-    def plot(self, ax=None, title: str | None = None):
-        """The spectrum with its labelled peaks (matplotlib axes; a new figure when ``ax`` is None)."""
-        from .plotting.spectrum import plot_labelled_spectrum
-
-        unit = next((u for suffix, u in SIGNAL_UNITS if self.signal.endswith(suffix)), "")
-        return plot_labelled_spectrum(
-            self.spectrum,
-            self.peaks,
-            ax=ax,
-            title=title or f"spectrum of {self.signal}",
-            unit=unit,
-            f_max_hz=self.f_max_hz,
-        )
 
 
 def _jsonable(obj: Any) -> Any:
