@@ -42,7 +42,7 @@ import numpy as np
 
 from ..model import Scenario
 from ..model.budget import coordinates
-from ..model.scenario import default_solver
+from ..model.solver import default_solver
 from .stiff_modes import coordinate_frequencies
 
 __all__ = [

@@ -22,7 +22,7 @@ from ..errors import GearbodyError, SimulationError
 from ..model import Scenario, load_scenario
 from ..model.budget import memory_limit_bytes
 from ..model.kinds import register_stage_kind, stage_kind
-from ..model.scenario import SOLVER_METHODS
+from ..model.solver import SOLVER_METHODS
 from ..result import Result
 from ..signals import stage_prefix
 from .build import BuiltSystem, build
