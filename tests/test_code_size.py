@@ -29,7 +29,6 @@ MODULE_REASON_LINES = 10
 PENDING = {
     # modules
     "assembly/stiff_modes.py",
-    "model/planetary.py",
     # functions
     "assembly/planetary_link.py:stage_static_displacements",
     "assembly/stiff_modes.py:_compound_frequencies",

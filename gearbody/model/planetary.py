@@ -1,6 +1,7 @@
 """A planetary stage of the drive: sun, N planets, internal ring and carrier (issue 19). One more item
 type of ``design.stages`` (``type = "planetary"``); the keys, coordinates and equations are the contract
-of docs/planetary.md, "The stage in a drive"."""
+of docs/planetary.md, "The stage in a drive". Its fault tables (damaged teeth, planet bearing defects)
+and their check are :mod:`gearbody.model.planetary_faults`."""
 
 from __future__ import annotations
 
@@ -14,9 +15,9 @@ from ..physics.planetary import PlanetaryGeometry, PlanetaryGeometryError, Plane
 from .components import MAX_TEETH, Bearing
 from .faults import ErrorMode
 from .params import Node, ScenarioError, param
+from .planetary_faults import PlanetaryDamagedTooth, PlanetBearingDefect, check_faults
 
 MEMBERS = ("sun", "ring", "carrier")
-TOOTHED = ("sun", "ring", "planet")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -99,26 +100,6 @@ class PlanetaryMesh(Node):
 
 
 @dataclass(frozen=True, kw_only=True)
-class PlanetaryDamagedTooth(Node):
-    """A cracked or broken tooth of a planetary member as a bare stiffness factor on every pair it is
-    in (docs/planetary.md, "Faults"): a sun or ring tooth in every planet's mesh with that member, a
-    planet tooth in its planet's sun and ring meshes."""
-
-    member: str = param(choices=TOOTHED, doc="toothed member: sun, ring or planet")
-    planet: int | None = param(None, ge=1, doc="planet number 1..N (member 'planet' only)")
-    tooth: int = param(ge=0, doc="tooth index, 0-based (numbering: docs/planetary.md, 'Faults')")
-    stiffness_factor: float = param(ge=0, le=1, doc="factor on k_z while this tooth meshes")
-
-
-@dataclass(frozen=True, kw_only=True)
-class PlanetBearingDefect(Node):
-    """A worn or loose planet bearing: its (isotropic) stiffness and damping times a factor."""
-
-    planet: int = param(ge=1, doc="planet number 1..N")
-    stiffness_factor: float = param(gt=0, le=1, doc="factor on the planet bearing's stiffness and damping")
-
-
-@dataclass(frozen=True, kw_only=True)
 class PlanetaryStage(Node):
     """A simple planetary stage: standard spur teeth (z_r = z_s + 2 z_p), N planets, any of sun, ring
     and carrier as input, output or fixed (the third)."""
@@ -182,7 +163,7 @@ class PlanetaryStage(Node):
             raise ScenarioError("planet.torsion_stiffness_Nm_per_rad: planets turn freely on the carrier")
         if self.planet_angles_deg:
             self._check_angles()
-        self._check_faults()
+        check_faults(self)
         try:
             self.geometry  # noqa: B018  (assembly condition, spacing, overlap: refused before anything runs)
         except PlanetaryGeometryError as exc:
@@ -215,67 +196,6 @@ class PlanetaryStage(Node):
                     f"integer (z_s + z_r = {total}); allowed: multiples of 360 / {total} = {step:.6g} deg, "
                     f"nearest valid angles [{nearest}]"
                 )
-
-    def _check_faults(self) -> None:
-        """Damaged teeth on existing teeth and planets (one entry per tooth), one pin error per planet
-        within a tenth of a module, bearing defects on existing planets (one per planet)."""
-        seen: dict[tuple, int] = {}
-        for i, t in enumerate(self.damaged_teeth, start=1):
-            key = f"damaged_teeth.{i}"
-            if t.member == "planet":
-                if t.planet is None:
-                    raise ScenarioError(
-                        f"{key}.planet: required for member 'planet'; allowed: 1..{self.planets}"
-                    )
-                if t.planet > self.planets:
-                    raise ScenarioError(f"{key}.planet = {t.planet}: allowed: 1..{self.planets}")
-            elif t.planet is not None:
-                raise ScenarioError(
-                    f"{key}.planet = {t.planet}: only for member 'planet' (a {t.member} tooth meets every "
-                    "planet); remove it"
-                )
-            z = getattr(self, t.member).teeth
-            if t.tooth >= z:
-                raise ScenarioError(
-                    f"{key}.tooth = {t.tooth} on the {t.member}: must be < its {z} teeth (0..{z - 1})"
-                )
-            ident = (t.member, t.planet, t.tooth)
-            if ident in seen:
-                raise ScenarioError(
-                    f"{key}: one entry per damaged tooth: {t.member} tooth {t.tooth} is also entry "
-                    f"{seen[ident]}"
-                )
-            seen[ident] = i
-        errors = self.planet_position_errors_um
-        if errors and len(errors) != self.planets:
-            raise ScenarioError(
-                f"planet_position_errors_um has {len(errors)} values: planets = {self.planets} needs one "
-                "per planet (or none)"
-            )
-        limit_um = 100.0 * self.module_mm
-        for n, e in enumerate(errors, start=1):
-            if not abs(e) <= limit_um:
-                raise ScenarioError(
-                    f"planet_position_errors_um.{n} = {e:g}: allowed: -{limit_um:g} .. {limit_um:g} um "
-                    "(a tenth of the module)"
-                )
-        if self.planet_bearing_defects and self.planet.bearing is not None:
-            raise ScenarioError(
-                "planet_bearing_defects: they weaken the linear planet bearing (bearing_stiffness_N_per_m); "
-                "with a planet bearing law, state the defect in its parameters"
-            )
-        planets: dict[int, int] = {}
-        for i, d in enumerate(self.planet_bearing_defects, start=1):
-            if d.planet > self.planets:
-                raise ScenarioError(
-                    f"planet_bearing_defects.{i}.planet = {d.planet}: allowed: 1..{self.planets}"
-                )
-            if d.planet in planets:
-                raise ScenarioError(
-                    f"planet_bearing_defects.{i}: planet {d.planet} is also entry {planets[d.planet]}; "
-                    "one defect per planet bearing"
-                )
-            planets[d.planet] = i
 
     def tooth_factors(self, member: str, planet: int | None = None) -> tuple[float, ...]:
         """Stiffness factor per tooth of the sun, the ring or planet ``planet`` (1-based): 1 unless
