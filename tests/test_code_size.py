@@ -28,11 +28,8 @@ MODULE_REASON_LINES = 10
 # or no longer exists), so the list cannot go stale.
 PENDING = {
     # modules
-    "assembly/stiff_modes.py",
     # functions
     "assembly/planetary_link.py:stage_static_displacements",
-    "assembly/stiff_modes.py:_compound_frequencies",
-    "assembly/stiff_modes.py:coordinate_frequencies",
     "assembly/planetary_layout.py:layout_from_geometry",
     "model/resolve.py:resolve_stage_geometry",
 }
