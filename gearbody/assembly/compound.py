@@ -31,9 +31,9 @@ from .planetary_link import (
     bearing_law_forces,
     has_bearing_laws,
     planetary_member_names,
-    stage_static_displacements,
     stage_stiffness_matrix,
 )
+from .planetary_static import stage_static_displacements
 from .system import Body, MatrixItem, PairMesh, SystemLayout
 from .topology import gear_names
 

@@ -1,7 +1,8 @@
 """A planetary stage in a drive's coordinates (:class:`PlanetaryLink`): its members' names, bodies,
 supports and force terms in the compound layout (:mod:`gearbody.assembly.compound`), its linearised
-stiffness, its bearing laws and its static state under given torques (docs/planetary.md, "The stage in a
-drive"). Registers the planetary stage kind's ``layout_part``."""
+stiffness and its bearing laws (docs/planetary.md, "The stage in a drive"); its static state under
+given torques is :mod:`gearbody.assembly.planetary_static`. Registers the planetary stage kind's
+``layout_part``."""
 
 from __future__ import annotations
 
@@ -9,12 +10,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
 from ..model import Scenario
 from ..model.kinds import register_stage_kind
 from ..physics.compiled import compiled
-from ..physics.mesh import I_LU, I_MU
-from ..physics.planetary_mesh import G_BEARING_K, G_DELTA0_RING, G_DELTA0_SUN, stage_forces
+from ..physics.planetary_mesh import stage_forces
 from ..signals import stage_prefix
 from .planetary_layout import CENTRAL, PlanetaryLayout, layout_from_stage
 from .system import Body, MatrixItem, SliceTerm, Spring, SystemLayout
@@ -25,18 +24,8 @@ __all__ = [
     "has_bearing_laws",
     "planetary_member_names",
     "planetary_part",
-    "stage_static_displacements",
     "stage_stiffness_matrix",
 ]
-
-
-MAX_NEWTON_ITERATIONS = 30
-REGULARISING_N_PER_M = 1e7
-LAW_NEWTON_ITERATIONS = 300
-"""The weak spring of the static start's first pass on members that sit on bearing laws, N/m."""
-STATIC_TOLERANCE = 1e-9
-"""Largest residual force of the static start, relative to the stage's largest external torque (N or
-N m per N m)."""
 
 
 def planetary_member_names(stage: int, planets: int) -> tuple[str, ...]:
@@ -209,122 +198,6 @@ def bearing_law_forces(link: PlanetaryLink, q_rel: np.ndarray, q_t: np.ndarray) 
         f[7] -= Fy
         f[8] -= rc * (c * Fy - s_ * Fx)
     return f
-
-
-def _support_forces(link: PlanetaryLink, q_rel: np.ndarray) -> np.ndarray:
-    """Central members' bearings and the fixed member's torsional support (elastic part) on the stage's
-    coordinates (displacements from the nominal assembly)."""
-    f = np.zeros(link.size)
-    for m, member in enumerate(link.layout.members):
-        o = 3 * m
-        f[o : o + 2] -= member.bearing_stiffness_N_per_m * q_rel[o : o + 2]
-        if member.torsion_stiffness_Nm_per_rad is not None:
-            f[o + 2] -= member.torsion_stiffness_Nm_per_rad * q_rel[o + 2]
-    if has_bearing_laws(link):
-        f += bearing_law_forces(link, q_rel, np.zeros(link.size))
-    return f
-
-
-def stage_static_displacements(
-    link: PlanetaryLink,
-    input_torque_Nm: float,
-    output_torque_Nm: float,
-    input_angle_rad: float = 0.0,
-    carrier_speed_rad_s: float = 0.0,
-) -> np.ndarray:
-    """Static equilibrium of a planetary stage (displacements from the nominal assembly) under the signed
-    external torques on its input and output members and the planets' centrifugal forces m_p w_c^2
-    (c_n - c_c) of a carrier turning at ``carrier_speed_rad_s``: exact deflections, the mesh laws at this
-    state without damping or friction; the input rotation held at ``input_angle_rad`` (the gauge);
-    Newton from the nominal assembly (docs/planetary.md, "Initial state")."""
-    ref, G_true = link.reference(), link.geometry_rows()
-    Ps_true, Pr_true = (P.copy() for P in link.layout.mesh_arrays())
-    Ps_true[..., I_MU] = Pr_true[..., I_MU] = 0.0  # the steady start ignores friction (as for trains)
-    # Solved on the loaded flanks: the backlash moved into the assembly deflection (delta - l_u with no
-    # clearance is the law's contact branch), so Newton starts from a law without a dead zone; the
-    # result is then checked with the true law (every loaded mesh on its flank).
-    G, Ps, Pr = G_true.copy(), Ps_true.copy(), Pr_true.copy()
-    G[:, G_DELTA0_SUN] += Ps[..., I_LU]
-    G[:, G_DELTA0_RING] += Pr[..., I_LU]
-    Ps[..., I_LU] = Pr[..., I_LU] = 0.0
-    gauge = 3 * CENTRAL.index(link.input) + 2
-    free = np.array([i for i in range(link.size) if i != gauge])
-    torques = np.zeros(link.size)
-    torques[3 * CENTRAL.index(link.input) + 2] += input_torque_Nm
-    torques[3 * CENTRAL.index(link.output) + 2] += output_torque_Nm
-    zero = np.zeros(link.size)
-    w2 = link.layout.planet.mass_kg * carrier_speed_rad_s**2
-
-    def residual(x: np.ndarray) -> np.ndarray:
-        q = np.zeros(link.size)
-        q[gauge] = input_angle_rad
-        q[free] = x
-        f = stage_forces(ref + q, zero, G, Ps, Pr) + _support_forces(link, q) + torques
-        c = ref + q
-        f[9::3] += w2 * (c[9::3] - c[6])
-        f[10::3] += w2 * (c[10::3] - c[7])
-        f[soft] -= regularise[0] * q[soft]
-        return f[free]
-
-    # A bearing law with a clearance carries nothing at the nominal assembly (its members then hang on
-    # the meshes alone, the carrier on nothing): first solved with a weak spring (REGULARISING_N_PER_M)
-    # on every translation of a member on a law, then without it from there (the bearings in contact).
-    lay = link.layout
-    soft = np.array(
-        [3 * m + d for m, mem in enumerate(lay.members) if mem.bearing_law for d in (0, 1)], dtype=int
-    )
-    regularise = [REGULARISING_N_PER_M if has_bearing_laws(link) else 0.0]
-    G_soft = G.copy()
-    if lay.planet.bearing_law is not None:  # the planets' weak spring acts on their pins (the carrier)
-        G_soft[:, G_BEARING_K] += REGULARISING_N_PER_M
-    G_free = G
-    # the residual's scale: the torques, or with no load the planets' centrifugal forces
-    scale = max(abs(input_torque_Nm), abs(output_torque_Nm), w2 * link.layout.carrier_radius_m, 1.0)
-    # Newton with a central-difference Jacobian (the laws are piecewise linear in the deflections, the
-    # geometry smooth): steps of 1e-9 m on centres and 1e-9 m / r_c on rotations
-    steps = np.array([1e-9 if i % 3 < 2 else 1e-9 / link.layout.carrier_radius_m for i in free])
-    x = np.zeros(free.size)
-
-    def newton(
-        x: np.ndarray, iterations: int = MAX_NEWTON_ITERATIONS, max_step_m: float = np.inf
-    ) -> np.ndarray:
-        r = residual(x)
-        for _ in range(iterations):
-            if np.max(np.abs(r)) <= STATIC_TOLERANCE * scale:
-                break
-            J = np.empty((free.size, free.size))
-            for j, h in enumerate(steps):
-                e = np.zeros(free.size)
-                e[j] = h
-                J[:, j] = (residual(x + e) - residual(x - e)) / (2 * h)
-            try:
-                dx = np.linalg.solve(J, r)
-            except np.linalg.LinAlgError:  # a member free in the backlash (no load): any equilibrium will do
-                dx = np.linalg.lstsq(J, r, rcond=None)[0]
-            longest = np.max(np.abs(dx / steps)) * 1e-9  # in m (rotations times r_c)
-            x = x - dx * min(1.0, max_step_m / longest)
-            r = residual(x)
-        return x
-
-    if regularise[0]:  # steps of at most a micrometre while the bearing contacts close
-        G = G_soft
-        x = newton(x, LAW_NEWTON_ITERATIONS, 1e-6)
-        G, regularise[0] = G_free, 0.0
-        x = newton(x, LAW_NEWTON_ITERATIONS, 1e-6)
-    x = newton(x)
-    G, Ps, Pr = G_true, Ps_true, Pr_true
-    x = newton(x)  # with the backlash: one step at most when every loaded mesh is on its flank
-    r = residual(x)
-    if not np.max(np.abs(r)) <= STATIC_TOLERANCE * scale:
-        raise InputError(
-            f"operation.initial_state = 'steady': stage {link.stage + 1}: no static equilibrium of the "
-            f"planetary stage found in {MAX_NEWTON_ITERATIONS} Newton steps (largest residual "
-            f"{np.max(np.abs(r)):.3g} N or N m); start from rest"
-        )
-    q = np.zeros(link.size)
-    q[gauge] = input_angle_rad
-    q[free] = x
-    return q
 
 
 def _stage_forces(link: PlanetaryLink):
