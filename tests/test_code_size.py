@@ -29,7 +29,6 @@ MODULE_REASON_LINES = 10
 PENDING = {
     # modules
     # functions
-    "assembly/planetary_layout.py:layout_from_geometry",
     "model/resolve.py:resolve_stage_geometry",
 }
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
@@ -215,51 +216,29 @@ def layout_from_geometry(
     factors shifted by M_n + floor(z_p / 2)); pin errors (m) and planet-bearing factors per planet.
     ``friction_coefficient``, ``friction_transition_speed_m_s``: mu and v_0 of every sun and ring mesh
     (docs/planetary.md, "Friction")."""
-    from ..physics.mesh import pack_mesh_parameters
     from ..physics.planetary import planet_mesh_phases
 
     g = geometry
     standard = contact_ratios(g)
-    eps_s, eps_r = (standard[k] if contact_ratio[k] is None else contact_ratio[k] for k in (0, 1))
     rbs, rbp, rbr = g.sun_base_radius_m, g.planet_base_radius_m, g.ring_base_radius_m
     widths = transition_width if isinstance(transition_width, tuple) else (transition_width,) * 2
-
-    sun_f, ring_f, planet_f = tooth_factors if tooth_factors is not None else (None, None, None)
-
-    def mesh(k: int, z1: int, r1: float, eps: float, pinion=None, wheel=None) -> np.ndarray:
-        depths = np.zeros(z1) if error_depths_m[k] is None else error_depths_m[k]
-        return pack_mesh_parameters(
-            pinion_factors=pinion,
-            wheel_factors=wheel,
-            r1_m=r1,
-            r2_m=rbp,
-            z1=z1,
-            z2=g.z_planet,
-            stiffness_single_N_per_m=stiffness_single_N_per_m[k],
-            stiffness_double_N_per_m=stiffness_double_N_per_m[k],
-            contact_ratio=eps,
-            damping_Ns_per_m=damping_Ns_per_m[k],
-            backlash_m=backlash_m[k],
-            friction_coefficient=friction_coefficient,
-            friction_transition_speed_m_s=friction_transition_speed_m_s,
-            pitch_point_phase=pitch_point_phase[k],
-            pressure_angle_rad=g.pressure_angle_rad,
-            error_a=error_a[k],
-            error_depths_m=depths,
-            transition_width=widths[k],
-        )
-
+    given = {  # (sun mesh, ring mesh) of each value of the mesh law
+        "stiffness_single_N_per_m": stiffness_single_N_per_m,
+        "stiffness_double_N_per_m": stiffness_double_N_per_m,
+        "contact_ratio": tuple(standard[k] if contact_ratio[k] is None else contact_ratio[k] for k in (0, 1)),
+        "damping_Ns_per_m": damping_Ns_per_m,
+        "backlash_m": backlash_m,
+        "pitch_point_phase": pitch_point_phase,
+        "error_a": error_a,
+        "error_depths_m": error_depths_m,
+        "transition_width": widths,
+    }
+    friction = {
+        "friction_coefficient": friction_coefficient,
+        "friction_transition_speed_m_s": friction_transition_speed_m_s,
+    }
     ring_offset = 2.0 * math.pi * planet_mesh_phases(g).ring_sun / g.z_ring
-    sun_mesh = mesh(0, g.z_sun, rbs, eps_s, sun_f)
-    ring_mesh = mesh(1, g.z_ring, rbr, eps_r, ring_f)
-    planet_meshes = None
-    if planet_f is not None and any(min(f) < 1.0 for f in planet_f):
-        rows_s, rows_r = [], []
-        for n, f in enumerate(planet_f):
-            f = np.asarray(f, float)
-            rows_s.append(mesh(0, g.z_sun, rbs, eps_s, sun_f, f))
-            rows_r.append(mesh(1, g.z_ring, rbr, eps_r, ring_f, f[ring_wheel_teeth(g, n)]))
-        planet_meshes = (np.array(rows_s), np.array(rows_r))
+    sun_mesh, ring_mesh, planet_meshes = _mesh_laws(g, given, friction, tooth_factors)
     return PlanetaryLayout(
         sun=sun,
         ring=ring,
@@ -276,6 +255,52 @@ def layout_from_geometry(
         planet_meshes=planet_meshes,
         pin_errors_m=tuple(pin_errors_m),
         bearing_factors=tuple(bearing_factors),
+    )
+
+
+def _mesh_laws(g, given: dict, friction: dict, tooth_factors: tuple | None) -> tuple:
+    """(sun mesh law, ring mesh law, each planet's own laws or None) of :func:`layout_from_geometry`:
+    ``given`` holds each value of the law as its (sun mesh, ring mesh) pair; each planet gets its own
+    laws (rows per planet) when one of its teeth is damaged, its ring mesh's wheel factors shifted by
+    :func:`ring_wheel_teeth`."""
+    rbs, rbr = g.sun_base_radius_m, g.ring_base_radius_m
+    sun_law, ring_law = (
+        partial(_planet_mesh_law, g, {key: pair[k] for key, pair in given.items()}, z1, r1, **friction)
+        for k, z1, r1 in ((0, g.z_sun, rbs), (1, g.z_ring, rbr))
+    )
+    sun_f, ring_f, planet_f = tooth_factors if tooth_factors is not None else (None, None, None)
+    sun_mesh = sun_law(sun_f)
+    ring_mesh = ring_law(ring_f)
+    if planet_f is None or not any(min(f) < 1.0 for f in planet_f):
+        return sun_mesh, ring_mesh, None
+    rows_s, rows_r = [], []
+    for n, f in enumerate(planet_f):
+        f = np.asarray(f, float)
+        rows_s.append(sun_law(sun_f, f))
+        rows_r.append(ring_law(ring_f, f[ring_wheel_teeth(g, n)]))
+    return sun_mesh, ring_mesh, (np.array(rows_s), np.array(rows_r))
+
+
+def _planet_mesh_law(
+    g, pair: dict, z1: int, r1: float, pinion=None, wheel=None, **friction: float
+) -> np.ndarray:
+    """The packed law of one mesh with the planet (the sun or the ring as its pinion, of ``z1`` teeth and
+    base radius ``r1``; the planet as its wheel): ``pair`` holds that mesh's values of the law by their
+    :func:`~gearbody.physics.mesh.pack_mesh_parameters` names (error depths None: none), ``pinion`` and
+    ``wheel`` the per-tooth stiffness factors (None: sound teeth)."""
+    from ..physics.mesh import pack_mesh_parameters
+
+    depths = pair["error_depths_m"]
+    return pack_mesh_parameters(
+        **{**pair, "error_depths_m": np.zeros(z1) if depths is None else depths},
+        pinion_factors=pinion,
+        wheel_factors=wheel,
+        r1_m=r1,
+        r2_m=g.planet_base_radius_m,
+        z1=z1,
+        z2=g.z_planet,
+        pressure_angle_rad=g.pressure_angle_rad,
+        **friction,
     )
 
 
