@@ -63,8 +63,42 @@ def resolve_stage_geometry(pinion, wheel, mesh, where: str):
                     "[geometry] table with module_mm and face_width_mm)"
                 )
         return pinion, wheel, mesh
-    g = mesh.geometry
     geo = pair_geometry(mesh, pinion.teeth, wheel.teeth, where)
+    _check_pair(geo, mesh, where)
+    out_gears = []
+    for name, gear, rb in (
+        ("pinion", pinion, geo.base_radius_pinion_m),
+        ("wheel", wheel, geo.base_radius_wheel_m),
+    ):
+        gw = where.replace("mesh.", "") + name + "."
+        out_gears.append(
+            dataclasses.replace(
+                gear,
+                base_radius_m=_agree(gw, "base_radius_m", gear.base_radius_m, rb),
+                face_width_m=_agree(gw, "face_width_m", gear.face_width_m, geo.face_width_m),
+            )
+        )
+    derived = {
+        "contact_ratio": _agree(where, "contact_ratio", mesh.contact_ratio, geo.transverse_contact_ratio),
+        "pitch_point_phase": _agree(
+            where, "pitch_point_phase", mesh.pitch_point_phase, geo.pitch_point_phase
+        ),
+        "pressure_angle_deg": _agree(
+            where, "pressure_angle_deg", mesh.pressure_angle_deg, math.degrees(geo.working_pressure_angle_rad)
+        ),
+    }
+    if mesh.geometry.sets_backlash:
+        derived["backlash_um"] = _agree(
+            where, "backlash_um", mesh.backlash_um, _backlash_um(geo, mesh, where)
+        )
+    derived.update(_stiffness_values(mesh, pinion.teeth, wheel.teeth, where))
+    return out_gears[0], out_gears[1], dataclasses.replace(mesh, **derived)
+
+
+def _check_pair(geo, mesh, where: str) -> None:
+    """What the mesh law of gearbody can take of a pair's geometry: spur teeth (a helical pair only with
+    the ISO stiffness), a transverse contact ratio below 2, the pitch point inside the mesh period."""
+    g = mesh.geometry
     if g.helix_angle_deg > 0 and mesh.stiffness_profile != "iso-6336-b":
         raise ScenarioError(
             f"{where}geometry.helix_angle_deg = {g.helix_angle_deg:g}: the potential-energy stiffness and "
@@ -82,50 +116,38 @@ def resolve_stage_geometry(pinion, wheel, mesh, where: str):
             f"{where}geometry: the pitch point lies outside the period's pair's mesh period (phase "
             f"{pitch:.4f}, allowed [0, 1]); balance the addenda or the profile shifts"
         )
-    out_gears = []
-    for name, gear, rb in (
-        ("pinion", pinion, geo.base_radius_pinion_m),
-        ("wheel", wheel, geo.base_radius_wheel_m),
-    ):
-        gw = where.replace("mesh.", "") + name + "."
-        out_gears.append(
-            dataclasses.replace(
-                gear,
-                base_radius_m=_agree(gw, "base_radius_m", gear.base_radius_m, rb),
-                face_width_m=_agree(gw, "face_width_m", gear.face_width_m, geo.face_width_m),
-            )
-        )
-    derived = {
-        "contact_ratio": _agree(where, "contact_ratio", mesh.contact_ratio, eps),
-        "pitch_point_phase": _agree(where, "pitch_point_phase", mesh.pitch_point_phase, pitch),
-        "pressure_angle_deg": _agree(
-            where, "pressure_angle_deg", mesh.pressure_angle_deg, math.degrees(geo.working_pressure_angle_rad)
-        ),
-    }
-    allowances = (g.thickness_allowance_pinion_um, g.thickness_allowance_wheel_um)
-    if g.sets_backlash:
-        from ..physics.gear_geometry import backlash_half_width_m, normal_backlash_m
 
-        j_bn = normal_backlash_m(
-            geo,
-            thickness_allowance_pinion_m=(allowances[0] or 0.0) * 1e-6,
-            thickness_allowance_wheel_m=(allowances[1] or 0.0) * 1e-6,
-            centre_distance_deviation_m=g.centre_distance_deviation_um * 1e-6,
+
+def _backlash_um(geo, mesh, where: str) -> float:
+    """Half the normal backlash the geometry's thickness allowances and centre-distance deviation give,
+    in µm (the mesh's backlash_um); a negative backlash (the teeth jam) is refused."""
+    from ..physics.gear_geometry import backlash_half_width_m, normal_backlash_m
+
+    g = mesh.geometry
+    allowances = (g.thickness_allowance_pinion_um, g.thickness_allowance_wheel_um)
+    j_bn = normal_backlash_m(
+        geo,
+        thickness_allowance_pinion_m=(allowances[0] or 0.0) * 1e-6,
+        thickness_allowance_wheel_m=(allowances[1] or 0.0) * 1e-6,
+        centre_distance_deviation_m=g.centre_distance_deviation_um * 1e-6,
+    )
+    if j_bn < 0:
+        raise ScenarioError(
+            f"{where}geometry: the allowances give a negative backlash ({j_bn * 1e6:.3g} µm): the teeth jam"
         )
-        if j_bn < 0:
-            raise ScenarioError(
-                f"{where}geometry: the allowances give a negative backlash ({j_bn * 1e6:.3g} µm): "
-                "the teeth jam"
-            )
-        derived["backlash_um"] = _agree(
-            where, "backlash_um", mesh.backlash_um, backlash_half_width_m(geo, j_bn) * 1e6
-        )
+    return backlash_half_width_m(geo, j_bn) * 1e6
+
+
+def _stiffness_values(mesh, teeth_pinion: int, teeth_wheel: int, where: str) -> dict[str, float]:
+    """The single/double stiffness the geometry fixes: the potential-energy profile's zone means (a given
+    value must agree), the defaults for the contact-ratio and table profiles where unset; none for the
+    ISO profile (computed later, at the rated force)."""
     if mesh.stiffness_profile == "potential-energy":
         from ..physics.mesh_stiffness import pair_stiffness_table
 
-        _check_bores(mesh, pinion.teeth, wheel.teeth, where)
+        _check_bores(mesh, teeth_pinion, teeth_wheel, where)
         try:
-            table = pair_stiffness_table(g, pinion.teeth, wheel.teeth)
+            table = pair_stiffness_table(mesh.geometry, teeth_pinion, teeth_wheel)
         except ValueError as exc:
             raise ScenarioError(f"{where}{exc}") from None
         except ArithmeticError:
@@ -134,17 +156,18 @@ def resolve_stage_geometry(pinion, wheel, mesh, where: str):
                 "its bore diameters, module and face width"
             ) from None
         single, double = table.zone_means_N_per_m()
-        derived["stiffness_single_N_per_m"] = _agree(
-            where, "stiffness_single_N_per_m", mesh.stiffness_single_N_per_m, single
-        )
-        derived["stiffness_double_N_per_m"] = _agree(
-            where, "stiffness_double_N_per_m", mesh.stiffness_double_N_per_m, double
-        )
-    elif mesh.stiffness_profile in ("contact-ratio", "table"):
-        for key in ("stiffness_single_N_per_m", "stiffness_double_N_per_m"):
-            if getattr(mesh, key) is None:
-                derived[key] = MESH_DEFAULTS[key]
-    return out_gears[0], out_gears[1], dataclasses.replace(mesh, **derived)
+        return {
+            "stiffness_single_N_per_m": _agree(
+                where, "stiffness_single_N_per_m", mesh.stiffness_single_N_per_m, single
+            ),
+            "stiffness_double_N_per_m": _agree(
+                where, "stiffness_double_N_per_m", mesh.stiffness_double_N_per_m, double
+            ),
+        }
+    if mesh.stiffness_profile in ("contact-ratio", "table"):
+        keys = ("stiffness_single_N_per_m", "stiffness_double_N_per_m")
+        return {key: MESH_DEFAULTS[key] for key in keys if getattr(mesh, key) is None}
+    return {}
 
 
 def _check_bores(mesh, teeth_pinion: int, teeth_wheel: int, where: str) -> None:
