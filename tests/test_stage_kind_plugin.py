@@ -192,15 +192,14 @@ def test_every_result_method_works_for_the_kind_or_refuses_in_one_line(belt_kind
 
 def test_no_module_outside_the_kinds_own_branches_on_a_stage_type():
     """Code that works for every stage asks the stage's kind; only a kind's own modules know its class."""
-    import sys
+    import importlib.util
     from pathlib import Path
 
-    root = Path(gearbody.__file__).resolve().parents[1]
-    sys.path.insert(0, str(root / "benchmarks"))
-    try:
-        from code_shape import STAGE_KIND
-    finally:
-        sys.path.pop(0)
+    root = Path(__file__).resolve().parents[1]  # the checkout (gearbody may be installed elsewhere)
+    spec = importlib.util.spec_from_file_location("code_shape", root / "benchmarks" / "code_shape.py")
+    code_shape = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(code_shape)
+    STAGE_KIND = code_shape.STAGE_KIND
     own = {  # the modules of the parallel and planetary kinds (each registers its hooks at its end)
         "model/scenario.py",
         "model/planetary.py",
