@@ -69,25 +69,19 @@ def labelled_spectrum(
     spec = amplitude_spectrum(result[name][win], result.sample_rate_hz, window="hann")
     peaks = []
     f_max = result.sample_rate_hz / 2
-    if not result._gear_train:
+    if result._gear_train:  # one train: its lines from the first mesh frequency and every pair's teeth
+        f_top = result.mesh_frequency_hz(0, fraction)
+    else:
         f_top = max(st.mesh_frequency_hz(result, k, fraction) for k, st in enumerate(result.stages))
-        if f_top > 0:
-            f_max = min(f_max, (harmonics + 0.5) * f_top)
-            lines = compound_lines(result, fraction, f_max, harmonics, sidebands)
-            peaks = label_peaks(
-                spec,
-                lines,
-                tolerance_hz=1.5 * spec.resolution_hz,
-                min_prominence_db=min_prominence_db,
-                max_peaks=max_peaks,
-                f_max_hz=f_max,
+    if f_top > 0:
+        f_max = min(f_max, (harmonics + 0.5) * f_top)
+        if result._gear_train:
+            teeth = [st.gear_pair() for st in result.stages]
+            lines = gear_train_lines(
+                f_top / teeth[0][0], teeth, f_max, harmonics=harmonics, sidebands=sidebands
             )
-        return LabelledSpectrum(signal=name, spectrum=spec, peaks=peaks, f_max_hz=f_max)
-    f_mesh = result.mesh_frequency_hz(0, fraction)
-    if f_mesh > 0:
-        f_max = min(f_max, (harmonics + 0.5) * f_mesh)
-        teeth = [st.gear_pair() for st in result.stages]
-        lines = gear_train_lines(f_mesh / teeth[0][0], teeth, f_max, harmonics=harmonics, sidebands=sidebands)
+        else:
+            lines = compound_lines(result, fraction, f_max, harmonics, sidebands)
         peaks = label_peaks(
             spec,
             lines,
