@@ -122,7 +122,7 @@ class PlanetaryLink:
 
     def drive_terms(self) -> list[SliceTerm]:
         """The stage's meshes and planet bearings, then its bearing laws, as terms of the drive item."""
-        terms = [SliceTerm(self.first, self.size, _stage_forces(self))]
+        terms = [SliceTerm(self.first, self.size, _stage_forces(self), _stage_kernel(self))]
         if has_bearing_laws(self):
             terms.append(SliceTerm(self.first, self.size, _law_forces(self)))
         return terms
@@ -214,6 +214,19 @@ def _stage_forces(link: PlanetaryLink):
         return stage
 
     return factory
+
+
+def _stage_kernel(link: PlanetaryLink):
+    """kernel() -> the compiled path's kernel of :func:`_stage_forces` and its packed parameters."""
+
+    def kernel():
+        from ..physics.kernels import pack, planetary_stage_kernel
+
+        Ps, Pr = link.layout.mesh_arrays()
+        block = pack([link.first, link.size], link.reference(), link.geometry_rows(), Ps, Pr)
+        return planetary_stage_kernel, block
+
+    return kernel
 
 
 def _law_forces(link: PlanetaryLink):

@@ -145,11 +145,15 @@ class SliceTerm:
     """Forces on the consecutive coordinates ``first .. first + size - 1``: ``forces(q, q_t)`` of those
     coordinates (numpy arrays) returns their generalised forces; ``factory()`` makes ``forces`` when the
     system is built (a layout is listed without compiling anything). A stage kind's laws enter the
-    drive through it (compiled or plain Python)."""
+    drive through it (compiled or plain Python); ``kernel()``, where given, returns the same forces as a
+    C kernel and its parameters for the compiled path (docs/extending.md)."""
 
     first: int
     size: int
     factory: Callable = field(repr=False)  # factory() -> forces(q, q_t), made when the system is built
+    # kernel() -> (numba cfunc, packed parameters) of the same forces for the compiled path
+    # (gearbody.physics.kernels); None: the drive item runs on the Python path
+    kernel: Callable | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,5 @@
 """Command line: ``gearbody list | new | run | modes | mesh | validate | sweep | sensitivity | calibrate |
-render``.
+render | info``.
 
 One module per command (``register(sub)`` adds its parser, ``execute(args)`` runs it; heavy imports
 happen inside ``execute``), the shared options and exit codes in :mod:`.common`. Exit codes: 0 ok,
@@ -28,7 +28,7 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from . import calibrate, listing, mesh, modes, new, render, run, sensitivity, sweep, validate
+from . import calibrate, info, listing, mesh, modes, new, render, run, sensitivity, sweep, validate
 from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_TERMINATED
 
 __all__ = ["main"]
@@ -44,9 +44,10 @@ EPILOG = """examples:
   gearbody validate one-stage
   gearbody render industrial-two-stage --frames 100 --out runs/pictures
   gearbody render one-stage --result runs/one-stage --view front --frame gears
+  gearbody info                                  (versions, and whether the force laws run compiled)
 """
 
-COMMANDS = (listing, new, run, modes, mesh, validate, sweep, sensitivity, calibrate, render)
+COMMANDS = (listing, new, run, modes, mesh, validate, sweep, sensitivity, calibrate, render, info)
 """In the order of ``gearbody --help``."""
 
 

@@ -41,6 +41,7 @@ from ..assembly.system import (
     SystemLayout,
     TorqueItem,
 )
+from .compiled_path import CompiledItem, NotCompiled, compiled_item, resolve_force_path, say_once
 from .user_functions import (
     StallWatchdog,
     bearing_user_function,
@@ -71,11 +72,23 @@ class BuiltSystem:
     fixed_coordinates: list[int] = field(default_factory=list)  # held at 0 (CoordinateConstraint)
     watchdog: StallWatchdog = field(default_factory=lambda: StallWatchdog())  # records a stall
 
+    @property
+    def force_path(self) -> str:
+        """``"compiled"`` (every force item called from C++), ``"python"`` (none), or ``"mixed"``."""
+        kinds = {isinstance(f, CompiledItem) for f in self.user_functions}
+        return "mixed" if len(kinds) > 1 else ("compiled" if True in kinds else "python")
 
-def build(layout: SystemLayout, q0=None, v0=None, *, sensors: bool = True) -> BuiltSystem:
+
+def build(
+    layout: SystemLayout, q0=None, v0=None, *, sensors: bool = True, force_path: str = "auto"
+) -> BuiltSystem:
     """The Exudyn system of ``layout`` at coordinates ``q0`` and velocities ``v0`` (one per coordinate of
     ``layout.dof_names``; default 0), assembled. ``sensors``: coordinates, velocities and accelerations of
-    every node stored at every step (what :func:`gearbody.engine.collect.collect` reads)."""
+    every node stored at every step (what :func:`gearbody.engine.collect.collect` reads).
+    ``force_path``: how Exudyn calls the force items, ``"compiled"`` (C++ calls the laws' kernels;
+    an item without kernels goes through Python, said once), ``"python"``, or ``"auto"`` (compiled
+    where it works here; :mod:`gearbody.engine.compiled_path`)."""
+    compiled = resolve_force_path(force_path) == "compiled"
     n = len(layout.dof_names)
     q0 = np.zeros(n) if q0 is None else np.asarray(q0, dtype=float)
     v0 = np.zeros(n) if v0 is None else np.asarray(v0, dtype=float)
@@ -127,14 +140,14 @@ def build(layout: SystemLayout, q0=None, v0=None, *, sensors: bool = True) -> Bu
                 )
             )
         else:
-            bodies, function = _force_function(item, layout, built.watchdog)
+            bodies, function = _force_function(item, layout, built.watchdog, compiled)
             built.user_functions.append(function)
             size = sum(layout.bodies[b].size for b in bodies)
             mbs.AddObject(
                 ObjectGenericODE2(
                     nodeNumbers=[nodes[b] for b in bodies],
                     massMatrix=np.zeros((size, size)),
-                    forceUserFunction=function,
+                    forceUserFunction=function.entry if isinstance(function, CompiledItem) else function,
                     visualization=HIDDEN,
                 )
             )
@@ -167,8 +180,18 @@ def _add_body(mbs, body, q0: np.ndarray, v0: np.ndarray) -> int:
     return nd
 
 
-def _force_function(item, layout: SystemLayout, watchdog: StallWatchdog):
-    """(bodies, user function) of a force item."""
+def _force_function(item, layout: SystemLayout, watchdog: StallWatchdog, compiled: bool = False):
+    """(bodies, user function) of a force item: on the compiled path a C++ entry where every term of the
+    item has a kernel (the Python function otherwise)."""
+    if compiled and not isinstance(item, ForceItem):
+        bodies = _item_bodies(item, layout)
+        size = sum(layout.bodies[b].size for b in bodies)
+        try:
+            entry = compiled_item(item, layout, size, _watched(item, watchdog))
+        except NotCompiled as why:
+            say_once(f"a {type(item).__name__} runs through Python (slower): {why}")
+        else:
+            return bodies, entry
     if isinstance(item, DriveItem):
         return tuple(range(len(layout.bodies))), drive_user_function(item, len(layout.dof_names), watchdog)
     if isinstance(item, MeshItem):
@@ -186,6 +209,23 @@ def _force_function(item, layout: SystemLayout, watchdog: StallWatchdog):
     if isinstance(item, ForceItem):
         return item.bodies, item.factory(watchdog)
     raise TypeError(f"{type(item).__name__} is not an item of a SystemLayout")
+
+
+def _item_bodies(item, layout: SystemLayout) -> tuple[int, ...]:
+    if isinstance(item, DriveItem):
+        return tuple(range(len(layout.bodies)))
+    if isinstance(item, (BearingItem, TorqueItem, MullerItem)):
+        return (item.body,)
+    return item.bodies
+
+
+def _watched(item, watchdog: StallWatchdog):
+    """(check, speed index) of the run's watchdog on the item that carries it (as on the Python path)."""
+    if isinstance(item, DriveItem):
+        return watchdog.ticker()[1], item.motor_at
+    if isinstance(item, MullerItem) or (isinstance(item, TorqueItem) and item.role == "motor"):
+        return watchdog.ticker()[1], 0
+    return None
 
 
 def _add_sensors(built: BuiltSystem) -> None:

@@ -64,7 +64,7 @@ def solver_settings(scenario: Scenario) -> exu.SimulationSettings:
 def build_scenario(scenario: Scenario) -> tuple[BuiltSystem, np.ndarray, np.ndarray]:
     """Exudyn system of a scenario at its initial state (an infeasible start raises InputError)."""
     layout, q0, v0 = drive_system(scenario)
-    return build(layout, q0, v0), q0, v0
+    return build(layout, q0, v0, force_path=scenario.solver.force_path), q0, v0
 
 
 def simulate(scenario: Scenario | str | Path, *, progress: bool = False) -> Result:
@@ -129,7 +129,12 @@ def simulate(scenario: Scenario | str | Path, *, progress: bool = False) -> Resu
     it = mbs.sys["dynamicSolver"].it
     result.meta["solver_statistics"]["rejected_steps"] = int(it.rejectedAutomaticStepSizeSteps)
     result.meta["solver_statistics"].update(
-        {"build_wall_s": build_s, "solve_wall_s": solve_s, "wall_time_s": time.perf_counter() - wall0}
+        {
+            "build_wall_s": build_s,
+            "solve_wall_s": solve_s,
+            "wall_time_s": time.perf_counter() - wall0,
+            "force_path": built.force_path,
+        }
     )
     return result
 

@@ -55,6 +55,9 @@ def default_solver(accuracy: str, topology: str, planetary: bool = False) -> tup
     return method, atol * (MULLER_TOLERANCE_SCALE if topology == "muller" else 1.0)
 
 
+FORCE_PATHS = ("auto", "compiled", "python")
+
+
 @dataclass(frozen=True, kw_only=True)
 class Solver(Node):
     accuracy: str = param(
@@ -88,4 +91,12 @@ class Solver(Node):
     )
     wall_time_limit_s: float | None = param(
         None, gt=0, doc="stop a run cleanly after this much wall-clock time solving (unset: no limit)"
+    )
+    # Exudyn calls the force laws either through Python functions or, on the compiled path, as numba
+    # kernels from C++ (gearbody.engine.compiled_path; the same laws, bit-identical forces).
+    force_path: str = param(
+        "auto",
+        choices=FORCE_PATHS,
+        doc="how Exudyn calls the force laws: compiled from C++, or through Python (auto: compiled where "
+        "the extension works)",
     )

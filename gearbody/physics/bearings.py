@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
+from numba import njit
 
 
 @runtime_checkable
@@ -106,23 +107,46 @@ class HertzianBearing:
         return np.array(self.force_xy(float(u[0]), float(u[1]), float(v[0]), float(v[1])))
 
     def force_xy(self, ux: float, uy: float, vx: float, vy: float) -> tuple[float, float]:
-        """Scalar form of :meth:`force_N` (the engine calls it when a law has one: fewer conversions)."""
-        r = math.hypot(ux, uy)
-        penetration = r - self.radial_clearance_m
-        if penetration <= 0.0 or r == 0.0:
-            return 0.0, 0.0
-        ex, ey = ux / r, uy / r
-        radial = self.contact_stiffness_N_per_m_n * penetration**self.exponent + self.damping_Ns_per_m * (
-            vx * ex + vy * ey
+        """Scalar form of :meth:`force_N` (the engine calls it when a law has one: fewer conversions):
+        the compiled :func:`hertz_force_xy`, the one the compiled path calls."""
+        return hertz_force_xy(
+            ux,
+            uy,
+            vx,
+            vy,
+            self.contact_stiffness_N_per_m_n,
+            self.radial_clearance_m,
+            self.exponent,
+            self.damping_Ns_per_m,
         )
-        if radial <= 0.0:
-            return 0.0, 0.0  # a bearing pushes, it never pulls
-        return -radial * ex, -radial * ey
+
+    def kernel(self, free_x: float, free_y: float):
+        """(cfunc, packed parameters) of this law on a gear's [x, y, rotation] for the compiled path, the
+        directions with ``free_* = 0`` held (gearbody.physics.kernels)."""
+        from .kernels import hertz_bearing_kernel, pack
+
+        p = [free_x, free_y, self.contact_stiffness_N_per_m_n, self.radial_clearance_m, self.exponent]
+        return hertz_bearing_kernel, pack([*p, self.damping_Ns_per_m])
 
     def potential_J(self, displacement_m) -> float:
         """Elastic energy stored in the contact (for checks): k_b p^(n+1) / (n+1)."""
         p = max(0.0, math.hypot(*np.asarray(displacement_m, float)) - self.radial_clearance_m)
         return self.contact_stiffness_N_per_m_n * p ** (self.exponent + 1) / (self.exponent + 1)
+
+
+@njit(cache=True)
+def hertz_force_xy(ux, uy, vx, vy, k_b, clearance_m, exponent, damping_Ns_per_m):
+    """The Hertzian law on plain floats: radial ``k_b max(0, |u| - c)^n + C u_r'`` towards the centre
+    while it pushes (N); (0, 0) out of contact."""
+    r = math.hypot(ux, uy)
+    penetration = r - clearance_m
+    if penetration <= 0.0 or r == 0.0:
+        return 0.0, 0.0
+    ex, ey = ux / r, uy / r
+    radial = k_b * penetration**exponent + damping_Ns_per_m * (vx * ex + vy * ey)
+    if radial <= 0.0:
+        return 0.0, 0.0  # a bearing pushes, it never pulls
+    return -radial * ex, -radial * ey
 
 
 def tangent_stiffness_damping(

@@ -1,0 +1,230 @@
+"""The compiled path: Exudyn calls gearbody's force laws from C++, with no Python call per evaluation.
+
+Exudyn fills a force user function through pybind11's ``std::function`` caster, which unwraps a stateless
+C++ function exported by a pybind11 module with exactly Exudyn's function type. The extension
+``gearbody.engine._force_entry`` (built by ``pip install``) exports such entries, one per slot; a slot
+holds the item's terms, each a numba ``cfunc`` of :mod:`gearbody.physics.kernels` and its packed
+parameters, so the laws are the same compiled functions the Python path calls, and the forces are
+bit-identical. Every CHECK_CALLS-th evaluation of the watched item calls the run's watchdog, as on the
+Python path.
+
+At first use a probe solves a one-mass system through an entry and checks that C++ counted its calls while
+none came through Python; if not (or the extension was not built), runs use the Python path, and gearbody
+says so once. ``solver.force_path`` chooses: ``"auto"`` (compiled where it works), ``"compiled"`` (an
+error where it does not), ``"python"``.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib
+import warnings
+import weakref
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..assembly.system import (
+    BearingItem,
+    DriveItem,
+    ForceItem,
+    MeshItem,
+    MullerItem,
+    SystemLayout,
+    TorqueItem,
+)
+from ..errors import InputError
+
+__all__ = [
+    "CompiledItem",
+    "PerformanceWarning",
+    "compiled_item",
+    "compiled_path_status",
+    "resolve_force_path",
+]
+
+
+class PerformanceWarning(UserWarning):
+    """gearbody runs, but slower than it could (the compiled path is not available, or an item of the
+    run has no compiled kernel)."""
+
+
+def _native():
+    """The extension module, or the reason it is missing."""
+    try:
+        return importlib.import_module("gearbody.engine._force_entry"), ""
+    except ImportError as exc:
+        return None, f"the extension gearbody.engine._force_entry is not built ({exc})"
+
+
+@functools.cache
+def compiled_path_status() -> tuple[bool, str]:
+    """(works, why not): whether Exudyn calls the compiled entries from C++ with no Python call (probed
+    once per process)."""
+    native, why = _native()
+    if native is None:
+        return False, why + "; reinstall gearbody with a C++ compiler (g++ or clang) to build it"
+    try:
+        calls, through_python = _probe(native)
+    except Exception as exc:  # noqa: BLE001 - any failure of the probe means: use the Python path
+        return False, f"the probe of the compiled path failed ({type(exc).__name__}: {exc})"
+    if calls == 0 or through_python:
+        return False, (
+            f"Exudyn called the compiled entry through Python ({through_python} of {calls} calls): the "
+            "extension and Exudyn do not share pybind11's function records (build gearbody against "
+            "the pybind11 release line of the installed Exudyn)"
+        )
+    return True, ""
+
+
+def _probe(native) -> tuple[int, int]:
+    """(calls counted in C++, calls that came through Python) of a one-mass system on a load kernel."""
+    import exudyn as exu
+    from exudyn.itemInterface import Node1D, ObjectGenericODE2, ObjectMass1D
+
+    from ..physics.kernels import load_kernel, pack
+
+    D = np.zeros(16)  # a drive block whose load torque is 0: the probe only counts calls
+    block = pack([0.0], D)
+    slot = native.acquire()
+    if slot < 0:
+        raise RuntimeError("no free slot")
+    try:
+        native.assign(slot, 1, [load_kernel.address], [block.ctypes.data])
+        before = native.python_calls()
+        SC = exu.SystemContainer()
+        mbs = SC.AddSystem()
+        nd = mbs.AddNode(
+            Node1D(referenceCoordinates=[0.0], initialCoordinates=[0.0], initialVelocities=[1.0])
+        )
+        mbs.AddObject(ObjectMass1D(nodeNumber=nd, mass=1.0))
+        mbs.AddObject(
+            ObjectGenericODE2(
+                nodeNumbers=[nd], massMatrix=np.zeros((1, 1)), forceUserFunction=native.entries[slot]
+            )
+        )
+        mbs.Assemble()
+        s = exu.SimulationSettings()
+        s.timeIntegration.endTime = 1e-3
+        s.timeIntegration.numberOfSteps = 10
+        s.timeIntegration.verboseMode = 0
+        s.solution.file.write = False
+        s.show.computationTime = False
+        exu.SolveDynamic(mbs, s, solverType=exu.DynamicSolverType.DOPRI5, showHints=False)
+        return int(native.calls(slot)), int(native.python_calls() - before)
+    finally:
+        native.release(slot)
+
+
+_SAID: set[str] = set()
+
+
+def say_once(message: str) -> None:
+    """Warn (PerformanceWarning) once per process per message."""
+    if message not in _SAID:
+        _SAID.add(message)
+        warnings.warn(message, PerformanceWarning, stacklevel=3)
+
+
+def resolve_force_path(setting: str) -> str:
+    """``"compiled"`` or ``"python"`` for ``solver.force_path`` = ``setting`` (auto: compiled where it
+    works, else python, said once; compiled where it does not work: InputError with the reason)."""
+    if setting == "python":
+        return "python"
+    works, why = compiled_path_status()
+    if works:
+        return "compiled"
+    if setting == "compiled":
+        raise InputError(
+            f"solver.force_path = 'compiled' is not available here: {why}. Use 'auto' or 'python'"
+        )
+    say_once(f"gearbody runs its force laws through Python (slower): {why}")
+    return "python"
+
+
+@dataclass
+class CompiledItem:
+    """A force item on the compiled path: its slot (one exported entry) and the parameter blocks the
+    kernels read (kept alive here); the slot is released when this object goes."""
+
+    slot: int
+    entry: object
+    blocks: list[np.ndarray] = field(repr=False)
+    kernels: list = field(repr=False)
+
+    def calls(self) -> int:
+        """Evaluations of this item so far, counted in C++."""
+        native, _ = _native()
+        return int(native.calls(self.slot))
+
+
+class NotCompiled(Exception):
+    """An item (or one of its terms) has no compiled kernel; the message says which."""
+
+
+def compiled_item(item, layout: SystemLayout, size: int, watch=None) -> CompiledItem:
+    """The compiled entry of a force item on ``size`` coordinates (``watch``: ``(check, speed index)``
+    of the run's watchdog). Raises :class:`NotCompiled` for an item with a term that has no kernel."""
+    native, why = _native()
+    if native is None:
+        raise NotCompiled(why)
+    terms = _terms(item, size)
+    slot = native.acquire()
+    if slot < 0:
+        raise NotCompiled(f"all {native.SLOTS} compiled slots of this process are in use")
+    blocks = [np.ascontiguousarray(b, dtype=np.float64) for _, b in terms]
+    native.assign(slot, size, [k.address for k, _ in terms], [b.ctypes.data for b in blocks])
+    if watch is not None:
+        from .user_functions import CHECK_CALLS
+
+        check, speed_index = watch
+        native.watch(slot, check, CHECK_CALLS, speed_index)
+    out = CompiledItem(slot, native.entries[slot], blocks, [k for k, _ in terms])
+    weakref.finalize(out, native.release, slot)
+    return out
+
+
+def _terms(item, size: int) -> list[tuple[object, np.ndarray]]:
+    """(kernel, packed parameters) of each term of a force item, in the order the Python path adds them."""
+    from ..physics import kernels as K
+
+    if isinstance(item, DriveItem):
+        return _drive_terms(item, size, K)
+    if isinstance(item, MeshItem):
+        if item.geometry is None:
+            return [(K.pair_mesh_kernel, K.pack([0.0, 1.0], item.parameters))]
+        return [(K.lateral_mesh_kernel, K.pack(item.index, item.geometry, item.parameters))]
+    if isinstance(item, BearingItem):
+        kernel = getattr(item.law, "kernel", None)
+        if kernel is None:
+            raise NotCompiled(f"the bearing law {type(item.law).__name__} has no compiled kernel")
+        mask = [float(d in item.free_directions) for d in (0, 1)]
+        return [kernel(*mask)]
+    if isinstance(item, TorqueItem):
+        return [((K.motor_kernel if item.role == "motor" else K.load_kernel), K.pack([0.0], item.drive))]
+    if isinstance(item, MullerItem):
+        return [(K.muller_kernel, K.pack(item.parameters, item.drive, [item.rated_force_N]))]
+    if isinstance(item, ForceItem):
+        raise NotCompiled("a ForceItem is a Python function")
+    raise TypeError(f"{type(item).__name__} is not an item of a SystemLayout")
+
+
+def _drive_terms(item: DriveItem, size: int, K) -> list:
+    if not item.terms and len(item.meshes) == 1 and size == 4:
+        m = item.meshes[0]
+        if (item.motor_at, m.pinion, m.wheel, item.load_at) == (0, 1, 2, 3):
+            return [(K.single_mesh_drive_kernel, K.pack(m.parameters, item.drive))]
+    terms = [
+        (K.motor_kernel, K.pack([float(item.motor_at)], item.drive)),
+        (K.load_kernel, K.pack([float(item.load_at)], item.drive)),
+    ]
+    terms += [
+        (K.pair_mesh_kernel, K.pack([float(m.pinion), float(m.wheel)], m.parameters)) for m in item.meshes
+    ]
+    for term in item.terms:
+        if term.kernel is None:
+            raise NotCompiled(
+                f"a term on coordinates {term.first}..{term.first + term.size - 1} has no compiled kernel"
+            )
+        terms.append(term.kernel())
+    return terms

@@ -1,0 +1,155 @@
+"""The force laws as C-callable kernels (numba ``cfunc``), for the compiled path: Exudyn calls them from
+C++ with no Python (gearbody.engine.compiled_path). Engine-free.
+
+Every kernel has one C signature, ``void kernel(double t, int64 n, const double *q, const double *q_t,
+double *f, const double *P)``: ``q``, ``q_t`` the ``n`` coordinates of its force item, ``f`` the item's
+forces, to which the kernel *adds* its own, and ``P`` its packed parameters, made by :func:`pack` from
+the same arrays the Python path passes to the same compiled law, so both paths compute bit-identical
+forces. An item's forces are the sum of its terms in order, from zero, as on the Python path.
+
+A packed block ``P`` is ``[length, parts, (offset, rows, columns) per part, data...]`` (``columns`` 0: a
+1-D part); :func:`part` and :func:`part2` read a part back as a view. Kernels are cached on disk by
+numba (compiled once per machine and numba version).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import carray, cfunc, njit, types
+
+from .bearings import hertz_force_xy
+from .lateral import lateral_mesh_forces
+from .mesh import contact_force, single_mesh_drive_forces, torsional_mesh_forces
+from .motor import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
+from .planetary_mesh import stage_forces
+
+__all__ = ["KERNEL_SIGNATURE", "pack", "part", "part2"]
+
+_double_p = types.CPointer(types.float64)
+KERNEL_SIGNATURE = types.void(types.float64, types.int64, _double_p, _double_p, _double_p, _double_p)
+
+
+def pack(*parts) -> np.ndarray:
+    """One float64 block of ``parts`` (scalars, 1-D or 2-D arrays), in the layout :func:`part` reads."""
+    arrays = [np.atleast_1d(np.asarray(p, dtype=np.float64)) for p in parts]
+    header = 2 + 3 * len(arrays)
+    out = [np.array([0.0, len(arrays)])]
+    table, offset = [], header
+    for a in arrays:
+        if a.ndim > 2:
+            raise ValueError(f"a packed part has at most 2 dimensions, not {a.ndim}")
+        table += [offset, a.shape[0], a.shape[1] if a.ndim == 2 else 0]
+        offset += a.size
+    out.append(np.array(table, dtype=np.float64))
+    out += [np.ascontiguousarray(a).ravel() for a in arrays]
+    block = np.concatenate(out)
+    block[0] = block.size
+    return block
+
+
+@njit(cache=True)
+def part(P, i):
+    """Part ``i`` of a packed block, 1-D view."""
+    o, r, c = int(P[2 + 3 * i]), int(P[3 + 3 * i]), int(P[4 + 3 * i])
+    return P[o : o + (r * c if c > 0 else r)]
+
+
+@njit(cache=True)
+def part2(P, i):
+    """Part ``i`` of a packed block, 2-D view (a 1-D part as one row)."""
+    o, r, c = int(P[2 + 3 * i]), int(P[3 + 3 * i]), int(P[4 + 3 * i])
+    if c == 0:
+        return P[o : o + r].reshape((1, r))
+    return P[o : o + r * c].reshape((r, c))
+
+
+@njit(cache=True)
+def _block(P):
+    return carray(P, (int(P[0]),))
+
+
+# --- kernels: (t, n, q, q_t, f, P) -------------------------------------------------------------------
+
+
+@cfunc(KERNEL_SIGNATURE, cache=True)
+def motor_kernel(t, n, q, q_t, f, P):
+    """P = pack(motor coordinate, drive parameters D): the motor torque."""
+    B = _block(P)
+    i = int(part(B, 0)[0])
+    f[i] += motor_torque_at(t, q_t[i], part(B, 1))
+
+
+@cfunc(KERNEL_SIGNATURE, cache=True)
+def load_kernel(t, n, q, q_t, f, P):
+    """P = pack(load coordinate, D): minus the load torque."""
+    B = _block(P)
+    i = int(part(B, 0)[0])
+    f[i] -= load_torque_at(t, part(B, 1))
+
+
+@cfunc(KERNEL_SIGNATURE, cache=True)
+def pair_mesh_kernel(t, n, q, q_t, f, P):
+    """P = pack([pinion, wheel] coordinates, mesh law): a torsional mesh (eq. 1)."""
+    B = _block(P)
+    at = part(B, 0)
+    ip, iw = int(at[0]), int(at[1])
+    a, b = torsional_mesh_forces(q[ip], q[iw], q_t[ip], q_t[iw], part(B, 1))
+    f[ip] += a
+    f[iw] += b
+
+
+@cfunc(KERNEL_SIGNATURE, cache=True)
+def single_mesh_drive_kernel(t, n, q, q_t, f, P):
+    """P = pack(mesh law, D): motor, pinion, wheel, load in one law (the one-stage drive)."""
+    B = _block(P)
+    a, b, c, d = single_mesh_drive_forces(t, q_t[0], q[1], q[2], q_t[1], q_t[2], part(B, 0), part(B, 1))
+    f[0] += a
+    f[1] += b
+    f[2] += c
+    f[3] += d
+
+
+@cfunc(KERNEL_SIGNATURE, cache=True)
+def lateral_mesh_kernel(t, n, q, q_t, f, P):
+    """P = pack(coordinate index, geometry, mesh law): a mesh where a gear translates."""
+    B = _block(P)
+    out = lateral_mesh_forces(
+        carray(q, (n,)), carray(q_t, (n,)), part(B, 0).astype(np.int64), part(B, 1), part(B, 2)
+    )
+    for i in range(n):
+        f[i] += out[i]
+
+
+@cfunc(KERNEL_SIGNATURE, cache=True)
+def hertz_bearing_kernel(t, n, q, q_t, f, P):
+    """P = pack([free x, free y, k_b, clearance, exponent, damping]): a Hertzian bearing on a gear."""
+    B = _block(P)
+    p = part(B, 0)
+    mx, my = p[0], p[1]
+    fx, fy = hertz_force_xy(q[0] * mx, q[1] * my, q_t[0] * mx, q_t[1] * my, p[2], p[3], p[4], p[5])
+    f[0] += fx * mx
+    f[1] += fy * my
+
+
+@cfunc(KERNEL_SIGNATURE, cache=True)
+def muller_kernel(t, n, q, q_t, f, P):
+    """P = pack(mesh law, D, rated force): Muller's reduced mass (Fig. 1)."""
+    B = _block(P)
+    Pm, D = part(B, 0), part(B, 1)
+    F = contact_force(synchronous_angle_at(t, D), q[0], q_t[0], Pm)[0]
+    f[0] += part(B, 2)[0] * load_fraction_at(t, D) - F
+
+
+@cfunc(KERNEL_SIGNATURE, cache=True)
+def planetary_stage_kernel(t, n, q, q_t, f, P):
+    """P = pack([first, size], reference, geometry rows, sun law rows, ring law rows): a planetary
+    stage's meshes and planet bearings on its coordinates (displacements from the reference)."""
+    B = _block(P)
+    at = part(B, 0)
+    a, size = int(at[0]), int(at[1])
+    qa, qta = carray(q, (n,)), carray(q_t, (n,))
+    out = stage_forces(
+        qa[a : a + size] + part(B, 1), qta[a : a + size], part2(B, 2), part2(B, 3), part2(B, 4)
+    )
+    for i in range(size):
+        f[a + i] += out[i]
