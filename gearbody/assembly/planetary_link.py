@@ -13,7 +13,7 @@ import numpy as np
 from ..model import Scenario
 from ..model.kinds import register_stage_kind
 from ..physics.compiled import compiled
-from ..physics.planetary_mesh import stage_forces
+from ..physics.planetary_mesh import stage_bearing_law_forces, stage_forces
 from ..signals import stage_prefix
 from .planetary_layout import CENTRAL, PlanetaryLayout, layout_from_stage
 from .system import Body, MatrixItem, SliceTerm, Spring, SystemLayout
@@ -124,7 +124,7 @@ class PlanetaryLink:
         """The stage's meshes and planet bearings, then its bearing laws, as terms of the drive item."""
         terms = [SliceTerm(self.first, self.size, _stage_forces(self), _stage_kernel(self))]
         if has_bearing_laws(self):
-            terms.append(SliceTerm(self.first, self.size, _law_forces(self)))
+            terms.append(SliceTerm(self.first, self.size, _law_forces(self), _laws_kernel(self)))
         return terms
 
 
@@ -229,16 +229,62 @@ def _stage_kernel(link: PlanetaryLink):
     return kernel
 
 
+def law_rows(link: PlanetaryLink) -> tuple[np.ndarray, np.ndarray] | None:
+    """(law rows of sun, ring, carrier, planet; pin rows: angle, nominal centre) for the compiled
+    :func:`gearbody.physics.planetary_mesh.stage_bearing_law_forces`, or None when a law has no
+    ``law_row`` (a user's Python law)."""
+    lay = link.layout
+    laws = [m.bearing_law for m in (*lay.members, lay.planet)]
+    if any(law is not None and not hasattr(law, "law_row") for law in laws):
+        return None
+    rows = [np.zeros(5) if law is None else np.asarray(law.law_row(), float) for law in laws]
+    width = max(r.size for r in rows)
+    table = np.zeros((4, width))
+    for i, r in enumerate(rows):
+        table[i, : r.size] = r
+    pins = np.array(
+        [(lay.pin_angle_rad(n), *lay.planet_centre_m(n)) for n in range(len(lay.planet_angles_rad))], float
+    )
+    return table, pins
+
+
 def _law_forces(link: PlanetaryLink):
-    """factory() -> the stage's Python bearing laws (docs/planetary.md, "Bearing laws")."""
+    """factory() -> the stage's bearing laws (docs/planetary.md, "Bearing laws"): the compiled function
+    the compiled path calls where every law has a row, else the laws' own ``force_N``."""
 
     def factory():
-        def laws(q, q_t):
-            return bearing_law_forces(link, q, q_t)
+        rows = law_rows(link)
+        if rows is None:
 
-        return laws
+            def laws(q, q_t):
+                return bearing_law_forces(link, q, q_t)
+
+            return laws
+        table, pins = rows
+        rc = link.layout.carrier_radius_m
+        forces = compiled(stage_bearing_law_forces, np.zeros(link.size), np.zeros(link.size), table, rc, pins)
+
+        def compiled_laws(q, q_t):
+            return forces(q, q_t, table, rc, pins)
+
+        return compiled_laws
 
     return factory
+
+
+def _laws_kernel(link: PlanetaryLink):
+    """kernel() -> the compiled path's kernel of the stage's bearing laws, or None (a Python law)."""
+    rows = law_rows(link)
+    if rows is None:
+        return None
+
+    def kernel():
+        from ..physics.kernels import pack, planetary_laws_kernel
+
+        table, pins = rows
+        return planetary_laws_kernel, pack([link.first, link.size, link.layout.carrier_radius_m], table, pins)
+
+    return kernel
 
 
 def planetary_part(scenario: Scenario, k: int, first: int, modal: bool) -> PlanetaryLink:

@@ -57,6 +57,14 @@ class LinearBearing:
             if not getattr(self, name) >= 0:
                 raise ValueError(f"LinearBearing.{name} = {getattr(self, name)!r}: must be >= 0")
 
+    def law_row(self) -> np.ndarray:
+        """This law as a row for the compiled :func:`law_force_xy`."""
+        k, c = (
+            (self.stiffness_x_N_per_m, self.stiffness_y_N_per_m),
+            (self.damping_x_Ns_per_m, self.damping_y_Ns_per_m),
+        )
+        return np.array([LAW_LINEAR, k[0], k[1], c[0], c[1]])
+
     def force_N(self, displacement_m, velocity_m_s) -> np.ndarray:
         u = np.asarray(displacement_m, float)
         v = np.asarray(velocity_m_s, float)
@@ -120,6 +128,11 @@ class HertzianBearing:
             self.damping_Ns_per_m,
         )
 
+    def law_row(self) -> np.ndarray:
+        """This law as a row for the compiled :func:`law_force_xy`."""
+        p = (self.contact_stiffness_N_per_m_n, self.radial_clearance_m, self.exponent, self.damping_Ns_per_m)
+        return np.array([LAW_HERTZIAN, *p])
+
     def kernel(self, free_x: float, free_y: float):
         """(cfunc, packed parameters) of this law on a gear's [x, y, rotation] for the compiled path, the
         directions with ``free_* = 0`` held (gearbody.physics.kernels)."""
@@ -147,6 +160,22 @@ def hertz_force_xy(ux, uy, vx, vy, k_b, clearance_m, exponent, damping_Ns_per_m)
     if radial <= 0.0:
         return 0.0, 0.0  # a bearing pushes, it never pulls
     return -radial * ex, -radial * ey
+
+
+LAW_LINEAR, LAW_HERTZIAN = 1.0, 2.0
+"""Codes of the shipped laws in a law row ``[code, parameters...]`` (a law's ``law_row()``), read by
+:func:`law_force_xy` where a compiled function needs a law chosen at run time (a planetary stage's
+bearings)."""
+
+
+@njit(cache=True)
+def law_force_xy(row, ux, uy, vx, vy):
+    """Force (N) of the law in ``row`` (:data:`LAW_LINEAR` ``[k_x, k_y, C_x, C_y]`` or
+    :data:`LAW_HERTZIAN` ``[k_b, c, n, C]``) on plain floats: the same arithmetic as the law's
+    ``force_N``."""
+    if row[0] == LAW_LINEAR:
+        return -(row[1] * ux + row[3] * vx), -(row[2] * uy + row[4] * vy)
+    return hertz_force_xy(ux, uy, vx, vy, row[1], row[2], row[3], row[4])
 
 
 def tangent_stiffness_damping(

@@ -21,7 +21,7 @@ from .bearings import hertz_force_xy
 from .lateral import lateral_mesh_forces
 from .mesh import contact_force, single_mesh_drive_forces, torsional_mesh_forces
 from .motor import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
-from .planetary_mesh import stage_forces
+from .planetary_mesh import stage_bearing_law_forces, stage_forces
 
 __all__ = ["KERNEL_SIGNATURE", "pack", "part", "part2"]
 
@@ -151,5 +151,18 @@ def planetary_stage_kernel(t, n, q, q_t, f, P):
     out = stage_forces(
         qa[a : a + size] + part(B, 1), qta[a : a + size], part2(B, 2), part2(B, 3), part2(B, 4)
     )
+    for i in range(size):
+        f[a + i] += out[i]
+
+
+@cfunc(KERNEL_SIGNATURE, cache=True)
+def planetary_laws_kernel(t, n, q, q_t, f, P):
+    """P = pack([first, size, carrier radius], law rows, pin rows): a planetary stage's bearing laws
+    (:func:`gearbody.physics.planetary_mesh.stage_bearing_law_forces`) on its coordinates."""
+    B = _block(P)
+    at = part(B, 0)
+    a, size = int(at[0]), int(at[1])
+    qa, qta = carray(q, (n,)), carray(q_t, (n,))
+    out = stage_bearing_law_forces(qa[a : a + size], qta[a : a + size], part2(B, 1), at[2], part2(B, 2))
     for i in range(size):
         f[a + i] += out[i]

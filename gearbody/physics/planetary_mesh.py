@@ -42,6 +42,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
+from .bearings import law_force_xy
 from .mesh import I_ARM1, contact_force, friction_force
 
 __all__ = [
@@ -330,3 +331,45 @@ def stage_contact_series(
             out[m, k, 0], out[m, k, 1], out[m, k, 2] = c[0], c[1], c[2]
             out[m, k, 3], out[m, k, 4], out[m, k, 5] = c[7], c[8], c[9]
     return out
+
+
+@njit(cache=True)
+def stage_bearing_law_forces(
+    q_rel: np.ndarray, q_t: np.ndarray, laws: np.ndarray, carrier_radius_m: float, pins: np.ndarray
+) -> np.ndarray:
+    """Generalised forces of a planetary stage's bearing laws (docs/planetary.md, "Bearing laws") on its
+    coordinates (``q_rel`` displacements from the nominal assembly, ``q_t`` velocities): ``laws`` one
+    row per sun, ring, carrier and the planets (``[0, ...]``: the linear bearing, not a law here; else
+    :func:`gearbody.physics.bearings.law_force_xy`'s row), ``pins`` one row per planet: pin angle (rad),
+    nominal centre x, y (m). A central member's law takes its centre's motion; a planet's law its offset
+    from its pin in the carrier frame, its force acting on the planet and, reversed, on the carrier."""
+    f = np.zeros(q_rel.size)
+    for m in range(3):
+        if laws[m, 0] != 0.0:
+            o = 3 * m
+            fx, fy = law_force_xy(laws[m], q_rel[o], q_rel[o + 1], q_t[o], q_t[o + 1])
+            f[o] += fx
+            f[o + 1] += fy
+    if laws[3, 0] == 0.0:
+        return f
+    rc = carrier_radius_m
+    xc, yc, tc = q_rel[6], q_rel[7], q_rel[8]
+    vxc, vyc, wc = q_t[6], q_t[7], q_t[8]
+    for n in range(pins.shape[0]):
+        b = 9 + 3 * n
+        a = tc + pins[n, 0]
+        c, s_ = math.cos(a), math.sin(a)
+        ex = pins[n, 1] + q_rel[b] - (xc + rc * c)
+        ey = pins[n, 2] + q_rel[b + 1] - (yc + rc * s_)
+        vx = q_t[b] - (vxc - rc * s_ * wc)
+        vy = q_t[b + 1] - (vyc + rc * c * wc)
+        fr, ft = law_force_xy(
+            laws[3], c * ex + s_ * ey, -s_ * ex + c * ey, c * vx + s_ * vy, -s_ * vx + c * vy
+        )
+        Fx, Fy = c * fr - s_ * ft, s_ * fr + c * ft
+        f[b] += Fx
+        f[b + 1] += Fy
+        f[6] -= Fx
+        f[7] -= Fy
+        f[8] -= rc * (c * Fy - s_ * Fx)
+    return f
