@@ -134,7 +134,7 @@ def test_an_item_without_a_kernel_runs_through_python_beside_compiled_ones(monke
     from gearbody.physics.bearings import HertzianBearing
 
     monkeypatch.setattr(compiled_path, "_SAID", set())
-    monkeypatch.delattr(HertzianBearing, "kernel")
+    monkeypatch.delattr(HertzianBearing, "law_row")
     sc = load_scenario("lateral-8dof-ball", ["operation.t_end_s=0.005"])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -80,6 +80,8 @@ def _attribute_docstrings() -> dict[str, list[tuple[str, str]]]:
         if name.endswith(".__main__"):
             continue
         spec = importlib.util.find_spec(name)
+        if not spec.origin.endswith(".py"):  # the compiled path's extension module
+            continue
         tree = ast.parse(open(spec.origin).read())
         body = tree.body
         for node, after in zip(body, body[1:], strict=False):

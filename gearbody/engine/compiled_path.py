@@ -195,11 +195,12 @@ def _terms(item, size: int) -> list[tuple[object, np.ndarray]]:
             return [(K.pair_mesh_kernel, K.pack([0.0, 1.0], item.parameters))]
         return [(K.lateral_mesh_kernel, K.pack(item.index, item.geometry, item.parameters))]
     if isinstance(item, BearingItem):
-        kernel = getattr(item.law, "kernel", None)
-        if kernel is None:
-            raise NotCompiled(f"the bearing law {type(item.law).__name__} has no compiled kernel")
         mask = [float(d in item.free_directions) for d in (0, 1)]
-        return [kernel(*mask)]
+        if hasattr(item.law, "kernel"):  # the law's own compiled kernel
+            return [item.law.kernel(*mask)]
+        if hasattr(item.law, "law_row"):  # a shipped law, by its row
+            return [(K.bearing_law_kernel, K.pack(mask, item.law.law_row()))]
+        raise NotCompiled(f"the bearing law {type(item.law).__name__} has no compiled kernel")
     if isinstance(item, TorqueItem):
         return [((K.motor_kernel if item.role == "motor" else K.load_kernel), K.pack([0.0], item.drive))]
     if isinstance(item, MullerItem):

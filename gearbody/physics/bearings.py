@@ -133,14 +133,6 @@ class HertzianBearing:
         p = (self.contact_stiffness_N_per_m_n, self.radial_clearance_m, self.exponent, self.damping_Ns_per_m)
         return np.array([LAW_HERTZIAN, *p])
 
-    def kernel(self, free_x: float, free_y: float):
-        """(cfunc, packed parameters) of this law on a gear's [x, y, rotation] for the compiled path, the
-        directions with ``free_* = 0`` held (gearbody.physics.kernels)."""
-        from .kernels import hertz_bearing_kernel, pack
-
-        p = [free_x, free_y, self.contact_stiffness_N_per_m_n, self.radial_clearance_m, self.exponent]
-        return hertz_bearing_kernel, pack([*p, self.damping_Ns_per_m])
-
     def potential_J(self, displacement_m) -> float:
         """Elastic energy stored in the contact (for checks): k_b p^(n+1) / (n+1)."""
         p = max(0.0, math.hypot(*np.asarray(displacement_m, float)) - self.radial_clearance_m)

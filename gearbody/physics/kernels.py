@@ -15,58 +15,16 @@ numba (compiled once per machine and numba version).
 from __future__ import annotations
 
 import numpy as np
-from numba import carray, cfunc, njit, types
+from numba import carray, cfunc
 
-from .bearings import hertz_force_xy
+from .bearings import law_force_xy
 from .lateral import lateral_mesh_forces
 from .mesh import contact_force, single_mesh_drive_forces, torsional_mesh_forces
 from .motor import load_fraction_at, load_torque_at, motor_torque_at, synchronous_angle_at
+from .packing import KERNEL_SIGNATURE, block, pack, part, part2
 from .planetary_mesh import stage_bearing_law_forces, stage_forces
 
 __all__ = ["KERNEL_SIGNATURE", "pack", "part", "part2"]
-
-_double_p = types.CPointer(types.float64)
-KERNEL_SIGNATURE = types.void(types.float64, types.int64, _double_p, _double_p, _double_p, _double_p)
-
-
-def pack(*parts) -> np.ndarray:
-    """One float64 block of ``parts`` (scalars, 1-D or 2-D arrays), in the layout :func:`part` reads."""
-    arrays = [np.atleast_1d(np.asarray(p, dtype=np.float64)) for p in parts]
-    header = 2 + 3 * len(arrays)
-    out = [np.array([0.0, len(arrays)])]
-    table, offset = [], header
-    for a in arrays:
-        if a.ndim > 2:
-            raise ValueError(f"a packed part has at most 2 dimensions, not {a.ndim}")
-        table += [offset, a.shape[0], a.shape[1] if a.ndim == 2 else 0]
-        offset += a.size
-    out.append(np.array(table, dtype=np.float64))
-    out += [np.ascontiguousarray(a).ravel() for a in arrays]
-    block = np.concatenate(out)
-    block[0] = block.size
-    return block
-
-
-@njit(cache=True)
-def part(P, i):
-    """Part ``i`` of a packed block, 1-D view."""
-    o, r, c = int(P[2 + 3 * i]), int(P[3 + 3 * i]), int(P[4 + 3 * i])
-    return P[o : o + (r * c if c > 0 else r)]
-
-
-@njit(cache=True)
-def part2(P, i):
-    """Part ``i`` of a packed block, 2-D view (a 1-D part as one row)."""
-    o, r, c = int(P[2 + 3 * i]), int(P[3 + 3 * i]), int(P[4 + 3 * i])
-    if c == 0:
-        return P[o : o + r].reshape((1, r))
-    return P[o : o + r * c].reshape((r, c))
-
-
-@njit(cache=True)
-def _block(P):
-    return carray(P, (int(P[0]),))
-
 
 # --- kernels: (t, n, q, q_t, f, P) -------------------------------------------------------------------
 
@@ -74,7 +32,7 @@ def _block(P):
 @cfunc(KERNEL_SIGNATURE, cache=True)
 def motor_kernel(t, n, q, q_t, f, P):
     """P = pack(motor coordinate, drive parameters D): the motor torque."""
-    B = _block(P)
+    B = block(P)
     i = int(part(B, 0)[0])
     f[i] += motor_torque_at(t, q_t[i], part(B, 1))
 
@@ -82,7 +40,7 @@ def motor_kernel(t, n, q, q_t, f, P):
 @cfunc(KERNEL_SIGNATURE, cache=True)
 def load_kernel(t, n, q, q_t, f, P):
     """P = pack(load coordinate, D): minus the load torque."""
-    B = _block(P)
+    B = block(P)
     i = int(part(B, 0)[0])
     f[i] -= load_torque_at(t, part(B, 1))
 
@@ -90,7 +48,7 @@ def load_kernel(t, n, q, q_t, f, P):
 @cfunc(KERNEL_SIGNATURE, cache=True)
 def pair_mesh_kernel(t, n, q, q_t, f, P):
     """P = pack([pinion, wheel] coordinates, mesh law): a torsional mesh (eq. 1)."""
-    B = _block(P)
+    B = block(P)
     at = part(B, 0)
     ip, iw = int(at[0]), int(at[1])
     a, b = torsional_mesh_forces(q[ip], q[iw], q_t[ip], q_t[iw], part(B, 1))
@@ -101,7 +59,7 @@ def pair_mesh_kernel(t, n, q, q_t, f, P):
 @cfunc(KERNEL_SIGNATURE, cache=True)
 def single_mesh_drive_kernel(t, n, q, q_t, f, P):
     """P = pack(mesh law, D): motor, pinion, wheel, load in one law (the one-stage drive)."""
-    B = _block(P)
+    B = block(P)
     a, b, c, d = single_mesh_drive_forces(t, q_t[0], q[1], q[2], q_t[1], q_t[2], part(B, 0), part(B, 1))
     f[0] += a
     f[1] += b
@@ -112,7 +70,7 @@ def single_mesh_drive_kernel(t, n, q, q_t, f, P):
 @cfunc(KERNEL_SIGNATURE, cache=True)
 def lateral_mesh_kernel(t, n, q, q_t, f, P):
     """P = pack(coordinate index, geometry, mesh law): a mesh where a gear translates."""
-    B = _block(P)
+    B = block(P)
     out = lateral_mesh_forces(
         carray(q, (n,)), carray(q_t, (n,)), part(B, 0).astype(np.int64), part(B, 1), part(B, 2)
     )
@@ -121,12 +79,13 @@ def lateral_mesh_kernel(t, n, q, q_t, f, P):
 
 
 @cfunc(KERNEL_SIGNATURE, cache=True)
-def hertz_bearing_kernel(t, n, q, q_t, f, P):
-    """P = pack([free x, free y, k_b, clearance, exponent, damping]): a Hertzian bearing on a gear."""
-    B = _block(P)
-    p = part(B, 0)
-    mx, my = p[0], p[1]
-    fx, fy = hertz_force_xy(q[0] * mx, q[1] * my, q_t[0] * mx, q_t[1] * my, p[2], p[3], p[4], p[5])
+def bearing_law_kernel(t, n, q, q_t, f, P):
+    """P = pack([free x, free y], law row): a bearing law (:func:`gearbody.physics.bearings.law_force_xy`)
+    on a gear's [x, y, rotation], the directions with free 0 held."""
+    B = block(P)
+    m = part(B, 0)
+    mx, my = m[0], m[1]
+    fx, fy = law_force_xy(part(B, 1), q[0] * mx, q[1] * my, q_t[0] * mx, q_t[1] * my)
     f[0] += fx * mx
     f[1] += fy * my
 
@@ -134,7 +93,7 @@ def hertz_bearing_kernel(t, n, q, q_t, f, P):
 @cfunc(KERNEL_SIGNATURE, cache=True)
 def muller_kernel(t, n, q, q_t, f, P):
     """P = pack(mesh law, D, rated force): Muller's reduced mass (Fig. 1)."""
-    B = _block(P)
+    B = block(P)
     Pm, D = part(B, 0), part(B, 1)
     F = contact_force(synchronous_angle_at(t, D), q[0], q_t[0], Pm)[0]
     f[0] += part(B, 2)[0] * load_fraction_at(t, D) - F
@@ -144,7 +103,7 @@ def muller_kernel(t, n, q, q_t, f, P):
 def planetary_stage_kernel(t, n, q, q_t, f, P):
     """P = pack([first, size], reference, geometry rows, sun law rows, ring law rows): a planetary
     stage's meshes and planet bearings on its coordinates (displacements from the reference)."""
-    B = _block(P)
+    B = block(P)
     at = part(B, 0)
     a, size = int(at[0]), int(at[1])
     qa, qta = carray(q, (n,)), carray(q_t, (n,))
@@ -159,7 +118,7 @@ def planetary_stage_kernel(t, n, q, q_t, f, P):
 def planetary_laws_kernel(t, n, q, q_t, f, P):
     """P = pack([first, size, carrier radius], law rows, pin rows): a planetary stage's bearing laws
     (:func:`gearbody.physics.planetary_mesh.stage_bearing_law_forces`) on its coordinates."""
-    B = _block(P)
+    B = block(P)
     at = part(B, 0)
     a, size = int(at[0]), int(at[1])
     qa, qta = carray(q, (n,)), carray(q_t, (n,))
