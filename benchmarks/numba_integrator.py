@@ -548,7 +548,8 @@ def simulate_numba(
         ip, iw = m.pinion, m.wheel
         delta = m.r_pinion_m * q[ip] - m.r_wheel_m * q[iw]
         rate = m.r_pinion_m * v[ip] - m.r_wheel_m * v[iw]
-        F, T = mesh_contact_series(np.ascontiguousarray(q[ip]), delta, rate, Pm)
+        wp, ww = np.ascontiguousarray(v[ip]), np.ascontiguousarray(v[iw])
+        F, T, _ = mesh_contact_series(np.ascontiguousarray(q[ip]), delta, rate, wp, ww, np.zeros_like(wp), Pm)
         forces.append(F)
         frictions.append(T)
     t_post = time.perf_counter()

@@ -284,10 +284,24 @@ def _stage_of(signal: str) -> int:
     return int(signal.split("_")[1]) - 1 if signal.startswith("stage_") else 0
 
 
+def _case_job(scene: str, case_name: str, short: bool, tolerance_percent: float) -> dict:
+    """One case as a job of gearbody's executors (a process pool): its CaseResult's fields."""
+    case = next(c for c in cases(scene, short) if c.name == case_name)
+    return {"ok": True, "result": compare_case(scene, case, short, tolerance_percent).__dict__}
+
+
 def run_validation(
-    scenes: list[str] | None = None, short: bool = False, tolerance_percent: float = 0.5, echo=print
+    scenes: list[str] | None = None,
+    short: bool = False,
+    tolerance_percent: float = 0.5,
+    echo=print,
+    workers: int | None = 1,
 ) -> bool:
-    """Run every case of the given scenes, print a table, return True when all pass."""
+    """Run every case of the given scenes, print a table (rows in case order), return True when all pass.
+    ``workers``: cases run on that many local processes at once (None: one per CPU; 1: in this process,
+    one after the other). Each case's wall times are its own process's."""
+    from gearbody.studies.executors import run_jobs
+
     scenes = list(scenes or VALIDATED_SCENES)
     todo = [(scene, case) for scene in scenes for case in cases(scene, short)]  # a bad scene: before output
     echo(
@@ -300,16 +314,26 @@ def run_validation(
         f"{'gearbody s':>12}{'reference s':>13}  result"
     )
     results = []
-    for scene, case in todo:
-        r = compare_case(scene, case, short, tolerance_percent)
-        results.append(r)
-        bearing = "-" if np.isnan(r.bearing_error_percent) else f"{r.bearing_error_percent:.4f}"
-        echo(
-            f"{r.scene:<22}{r.case:<12}{r.max_error_percent:>10.4f}{r.rms_error_percent:>10.4f}"
-            f"{bearing:>11}{r.kd_max:>9.3f}"
-            f"{r.separated_fraction:>7.2f}{r.wall_gearbody_s:>12.2f}{r.wall_reference_s:>13.2f}  "
-            f"{'PASS' if r.passed else 'FAIL'} {r.note}"
-        )
+    jobs = [(str(i), (scene, case.name, short, tolerance_percent)) for i, (scene, case) in enumerate(todo)]
+    done: dict[int, CaseResult] = {}
+    for jid, outcome in run_jobs(_case_job, jobs, workers=workers, name="gearbody-validate"):
+        if not outcome["ok"]:
+            scene, case = todo[int(jid)]
+            raise RuntimeError(f"validation case {scene} {case.name} failed: {outcome['message']}")
+        done[int(jid)] = CaseResult(**outcome["result"])
+        while len(results) in done:  # print the rows in case order as they become ready
+            _echo_row(echo, done[len(results)])
+            results.append(done[len(results)])
     ok = all(r.passed for r in results)
     echo("all cases pass" if ok else "SOME CASES FAIL")
     return ok
+
+
+def _echo_row(echo, r: CaseResult) -> None:
+    bearing = "-" if np.isnan(r.bearing_error_percent) else f"{r.bearing_error_percent:.4f}"
+    echo(
+        f"{r.scene:<22}{r.case:<12}{r.max_error_percent:>10.4f}{r.rms_error_percent:>10.4f}"
+        f"{bearing:>11}{r.kd_max:>9.3f}"
+        f"{r.separated_fraction:>7.2f}{r.wall_gearbody_s:>12.2f}{r.wall_reference_s:>13.2f}  "
+        f"{'PASS' if r.passed else 'FAIL'} {r.note}"
+    )

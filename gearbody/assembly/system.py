@@ -192,6 +192,11 @@ class SystemLayout:
             i += b.size
         return out
 
+    def coordinates_of(self, bodies: tuple[int, ...]) -> list[int]:
+        """Global coordinates of ``bodies`` in order: an item on ``bodies`` has them as its coordinates."""
+        firsts = self.first_coordinates
+        return [c for b in bodies for c in range(firsts[b], firsts[b] + self.bodies[b].size)]
+
     def body_of(self, coordinate: int) -> tuple[int, int]:
         """(body index, coordinate within the body) of a global coordinate."""
         for k, (first, b) in enumerate(zip(self.first_coordinates, self.bodies, strict=True)):

@@ -21,6 +21,12 @@ def register(sub) -> argparse.ArgumentParser:
     val.add_argument(
         "--tolerance", type=number(gt=0), default=0.5, help="max |dF|/F_rated in %% (default 0.5)"
     )
+    val.add_argument(
+        "--workers",
+        type=number(whole=True, ge=1),
+        default=None,
+        help="cases run at once on this many local processes (default: one per CPU; 1: one after the other)",
+    )
     val.set_defaults(handler=execute)
     return val
 
@@ -30,5 +36,7 @@ def execute(args) -> int:
 
     for scene in args.scenes:  # a misspelled scene fails before the table header
         load(scene, [])
-    ok = run_validation(args.scenes or None, short=args.short, tolerance_percent=args.tolerance)
+    ok = run_validation(
+        args.scenes or None, short=args.short, tolerance_percent=args.tolerance, workers=args.workers
+    )
     return EXIT_OK if ok else EXIT_FAILED

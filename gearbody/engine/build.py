@@ -3,9 +3,9 @@ body is an Exudyn node and object (a rotation or translation body ``Node1D`` wit
 or ``ObjectMass1D``; a planar body ``NodeRigidBody2D`` + ``ObjectRigidBody2D``, coordinates x, y,
 rotation), then each item in the layout's order: springs ``ObjectConnectorCoordinateSpringDamper``,
 constraints ``CoordinateConstraint`` to the ground (Exudyn's explicit solvers eliminate them; a modal
-layout lists them as fixed coordinates instead), constant matrices and user-function force items
-``ObjectGenericODE2`` (the force laws are the compiled ones of :mod:`gearbody.physics`; see
-:mod:`gearbody.engine.user_functions`).
+layout lists them as fixed coordinates instead), constant matrices, and at the first force item the
+layout's force items as user-function ``ObjectGenericODE2`` items, the laws of the drive in one
+(:mod:`gearbody.engine.force_items`; compiled or Python, :mod:`gearbody.engine.compiled_path`).
 """
 
 from __future__ import annotations
@@ -29,29 +29,10 @@ from exudyn.itemInterface import (
     VObjectGenericODE2,
 )
 
-from ..assembly.system import (
-    BearingItem,
-    Constraint,
-    DriveItem,
-    ForceItem,
-    MatrixItem,
-    MeshItem,
-    MullerItem,
-    Spring,
-    SystemLayout,
-    TorqueItem,
-)
-from .compiled_path import CompiledItem, NotCompiled, compiled_item, resolve_force_path, say_once
-from .user_functions import (
-    StallWatchdog,
-    bearing_user_function,
-    drive_user_function,
-    lateral_mesh_user_function,
-    load_user_function,
-    mesh_user_function,
-    motor_user_function,
-    muller_user_function,
-)
+from ..assembly.system import Constraint, MatrixItem, Spring, SystemLayout
+from .compiled_path import CompiledItem, resolve_force_path
+from .force_items import force_functions
+from .user_functions import StallWatchdog
 
 __all__ = ["BuiltSystem", "build"]
 
@@ -114,6 +95,7 @@ def build(
                 )
         return markers[coordinate]
 
+    forces_added = False
     for item in layout.items:
         if isinstance(item, Spring):
             mbs.AddObject(
@@ -139,18 +121,19 @@ def build(
                     visualization=HIDDEN,
                 )
             )
-        else:
-            bodies, function = _force_function(item, layout, built.watchdog, compiled)
-            built.user_functions.append(function)
-            size = sum(layout.bodies[b].size for b in bodies)
-            mbs.AddObject(
-                ObjectGenericODE2(
-                    nodeNumbers=[nodes[b] for b in bodies],
-                    massMatrix=np.zeros((size, size)),
-                    forceUserFunction=function.entry if isinstance(function, CompiledItem) else function,
-                    visualization=HIDDEN,
+        elif not forces_added:  # the first force item: every force item, as few Exudyn items as can be
+            forces_added = True
+            for bodies, function in force_functions(layout, built.watchdog, compiled):
+                built.user_functions.append(function)
+                size = sum(layout.bodies[b].size for b in bodies)
+                mbs.AddObject(
+                    ObjectGenericODE2(
+                        nodeNumbers=[nodes[b] for b in bodies],
+                        massMatrix=np.zeros((size, size)),
+                        forceUserFunction=function.entry if isinstance(function, CompiledItem) else function,
+                        visualization=HIDDEN,
+                    )
                 )
-            )
     if sensors:
         _add_sensors(built)
     mbs.Assemble()
@@ -178,54 +161,6 @@ def _add_body(mbs, body, q0: np.ndarray, v0: np.ndarray) -> int:
     else:
         mbs.AddObject(ObjectMass1D(nodeNumber=nd, mass=body.mass_kg))
     return nd
-
-
-def _force_function(item, layout: SystemLayout, watchdog: StallWatchdog, compiled: bool = False):
-    """(bodies, user function) of a force item: on the compiled path a C++ entry where every term of the
-    item has a kernel (the Python function otherwise)."""
-    if compiled and not isinstance(item, ForceItem):
-        bodies = _item_bodies(item, layout)
-        size = sum(layout.bodies[b].size for b in bodies)
-        try:
-            entry = compiled_item(item, layout, size, _watched(item, watchdog))
-        except NotCompiled as why:
-            say_once(f"a {type(item).__name__} runs through Python (slower): {why}")
-        else:
-            return bodies, entry
-    if isinstance(item, DriveItem):
-        return tuple(range(len(layout.bodies))), drive_user_function(item, len(layout.dof_names), watchdog)
-    if isinstance(item, MeshItem):
-        if item.geometry is None:
-            return item.bodies, mesh_user_function(item.parameters)
-        return item.bodies, lateral_mesh_user_function(item.parameters, item.geometry, item.index)
-    if isinstance(item, BearingItem):
-        return (item.body,), bearing_user_function(item.law, item.free_directions)
-    if isinstance(item, TorqueItem):
-        if item.role == "motor":
-            return (item.body,), motor_user_function(item.drive, watchdog)
-        return (item.body,), load_user_function(item.drive)
-    if isinstance(item, MullerItem):
-        return (item.body,), muller_user_function(item, watchdog)
-    if isinstance(item, ForceItem):
-        return item.bodies, item.factory(watchdog)
-    raise TypeError(f"{type(item).__name__} is not an item of a SystemLayout")
-
-
-def _item_bodies(item, layout: SystemLayout) -> tuple[int, ...]:
-    if isinstance(item, DriveItem):
-        return tuple(range(len(layout.bodies)))
-    if isinstance(item, (BearingItem, TorqueItem, MullerItem)):
-        return (item.body,)
-    return item.bodies
-
-
-def _watched(item, watchdog: StallWatchdog):
-    """(check, speed index) of the run's watchdog on the item that carries it (as on the Python path)."""
-    if isinstance(item, DriveItem):
-        return watchdog.ticker()[1], item.motor_at
-    if isinstance(item, MullerItem) or (isinstance(item, TorqueItem) and item.role == "motor"):
-        return watchdog.ticker()[1], 0
-    return None
 
 
 def _add_sensors(built: BuiltSystem) -> None:

@@ -37,9 +37,11 @@ from ..errors import InputError
 
 __all__ = [
     "CompiledItem",
+    "NotCompiled",
     "PerformanceWarning",
     "compiled_item",
     "compiled_path_status",
+    "item_terms",
     "resolve_force_path",
 ]
 
@@ -162,13 +164,12 @@ class NotCompiled(Exception):
     """An item (or one of its terms) has no compiled kernel; the message says which."""
 
 
-def compiled_item(item, layout: SystemLayout, size: int, watch=None) -> CompiledItem:
-    """The compiled entry of a force item on ``size`` coordinates (``watch``: ``(check, speed index)``
-    of the run's watchdog). Raises :class:`NotCompiled` for an item with a term that has no kernel."""
+def compiled_item(terms: list[tuple[object, np.ndarray]], size: int, watch=None) -> CompiledItem:
+    """The compiled entry of one Exudyn item on ``size`` coordinates whose forces are ``terms`` (kernel,
+    packed parameters), added in order (``watch``: ``(check, speed coordinate)`` of the run's watchdog)."""
     native, why = _native()
     if native is None:
         raise NotCompiled(why)
-    terms = _terms(item, size)
     slot = native.acquire()
     if slot < 0:
         raise NotCompiled(f"all {native.SLOTS} compiled slots of this process are in use")
@@ -184,30 +185,38 @@ def compiled_item(item, layout: SystemLayout, size: int, watch=None) -> Compiled
     return out
 
 
-def _terms(item, size: int) -> list[tuple[object, np.ndarray]]:
-    """(kernel, packed parameters) of each term of a force item, in the order the Python path adds them."""
+def item_terms(item, layout: SystemLayout) -> list[tuple[object, np.ndarray]]:
+    """(kernel, packed parameters) of each term of a force item on the layout's global coordinates, in
+    the order its Python function adds them. Raises :class:`NotCompiled` for an item without kernels."""
     from ..physics import kernels as K
 
-    if isinstance(item, DriveItem):
-        return _drive_terms(item, size, K)
-    if isinstance(item, MeshItem):
-        if item.geometry is None:
-            return [(K.pair_mesh_kernel, K.pack([0.0, 1.0], item.parameters))]
-        return [(K.lateral_mesh_kernel, K.pack(item.index, item.geometry, item.parameters))]
-    if isinstance(item, BearingItem):
-        mask = [float(d in item.free_directions) for d in (0, 1)]
-        if hasattr(item.law, "kernel"):  # the law's own compiled kernel
-            return [item.law.kernel(*mask)]
-        if hasattr(item.law, "law_row"):  # a shipped law, by its row
-            return [(K.bearing_law_kernel, K.pack(mask, item.law.law_row()))]
-        raise NotCompiled(f"the bearing law {type(item.law).__name__} has no compiled kernel")
-    if isinstance(item, TorqueItem):
-        return [((K.motor_kernel if item.role == "motor" else K.load_kernel), K.pack([0.0], item.drive))]
-    if isinstance(item, MullerItem):
-        return [(K.muller_kernel, K.pack(item.parameters, item.drive, [item.rated_force_N]))]
+    if _native()[0] is None:
+        raise NotCompiled(_native()[1])
+    if isinstance(item, DriveItem):  # on every body: its coordinates are the global ones
+        return _drive_terms(item, len(layout.dof_names), K)
     if isinstance(item, ForceItem):
         raise NotCompiled("a ForceItem is a Python function")
+    at = layout.coordinates_of(_item_bodies(item))
+    if isinstance(item, MeshItem):
+        if item.geometry is None:
+            return [(K.pair_mesh_kernel, K.pack([float(at[0]), float(at[1])], item.parameters))]
+        index = [float(at[i]) if i >= 0 else -1.0 for i in item.index]
+        return [(K.lateral_mesh_kernel, K.pack(index, item.geometry, item.parameters))]
+    if isinstance(item, BearingItem):
+        mask = [float(d in item.free_directions) for d in (0, 1)]
+        if hasattr(item.law, "law_row"):  # a shipped law, by its row
+            return [(K.bearing_law_kernel, K.pack([*mask, float(at[0])], item.law.law_row()))]
+        raise NotCompiled(f"the bearing law {type(item.law).__name__} has no law_row() for the compiled path")
+    if isinstance(item, TorqueItem):
+        kernel = K.motor_kernel if item.role == "motor" else K.load_kernel
+        return [(kernel, K.pack([float(at[0])], item.drive))]
+    if isinstance(item, MullerItem):
+        return [(K.muller_kernel, K.pack(item.parameters, item.drive, [item.rated_force_N, float(at[0])]))]
     raise TypeError(f"{type(item).__name__} is not an item of a SystemLayout")
+
+
+def _item_bodies(item) -> tuple[int, ...]:
+    return (item.body,) if isinstance(item, BearingItem | TorqueItem | MullerItem) else item.bodies
 
 
 def _drive_terms(item: DriveItem, size: int, K) -> list:
@@ -225,7 +234,7 @@ def _drive_terms(item: DriveItem, size: int, K) -> list:
     for term in item.terms:
         if term.kernel is None:
             raise NotCompiled(
-                f"a term on coordinates {term.first}..{term.first + term.size - 1} has no compiled kernel"
+                f"its term on coordinates {term.first}..{term.first + term.size - 1} has no compiled kernel"
             )
         terms.append(term.kernel())
     return terms
