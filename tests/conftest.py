@@ -7,10 +7,15 @@ from __future__ import annotations
 
 import os
 import subprocess
+import tempfile
 
 import pytest
 
 from gearbody.model import Scenario, load_scenario
+
+# `gearbody validate` keeps the reference's outputs in a cache; the tests run it afresh in a folder of
+# their own (never the user's ~/.cache), so every test process starts with an empty one.
+os.environ["GEARBODY_REFERENCE_CACHE"] = tempfile.mkdtemp(prefix="gearbody-test-reference-cache-")
 
 STEADY_OVERRIDES = (
     'operation.initial_state="steady"',

@@ -21,7 +21,9 @@ SCENES = list_scenes()
 T_END = "0.01"  # s: enough output samples for every plot's final window (20 kHz: 50 in the last 25 %)
 STUDY_T_END = "0.003"
 KEY = "condition.friction_coefficient"  # a key every drive has
-COVERED = {"list", "new", "run", "modes", "mesh", "render", "validate", "sweep", "sensitivity", "calibrate"}
+COVERED = {
+    "list", "new", "run", "modes", "mesh", "render", "validate", "sweep", "sensitivity", "calibrate", "info",
+}  # fmt: skip
 
 
 def _is_planetary(stage) -> bool:
@@ -52,6 +54,12 @@ def test_the_matrix_covers_every_command_and_every_listed_scene(capsys):
     assert listed == SCENES and len(SCENES) >= 15
     parsers = {c.__name__.rsplit(".", 1)[-1] for c in COMMANDS}
     assert {"listing" if c == "list" else c for c in COVERED} == parsers
+
+
+def test_info_names_the_versions_and_the_force_path(capsys):
+    assert main(["info"]) == 0
+    out = capsys.readouterr().out
+    assert "exudyn" in out and "force path" in out
 
 
 @pytest.mark.parametrize("scene", SCENES)

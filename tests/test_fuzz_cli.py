@@ -53,6 +53,7 @@ def _wall(command: str) -> list[str]:
 
 BASE = {
     "list": [],
+    "info": [],
     "new": ["--out", "drive.toml"],
     "run": ["--t-end", "0.003", "--no-plots", "--quiet", "--out", "out"],
     "modes": ["--harmonics", "2"],
@@ -426,7 +427,7 @@ def command_lines(draw, command: str) -> list:
     odd = draw(st.integers(0, 7)) == 0
     if command == "validate":
         tokens.append(draw(paths(SCENARIO_FILES)) if odd else VALIDATE_SCENE)
-    elif command != "list":
+    elif command not in ("list", "info"):
         tokens.append(draw(paths(SCENARIO_FILES)) if odd else draw(st.sampled_from(SCENES)))
     tokens += BASE[command] + _wall(command)
     if command in ("run", "new", "mesh", "render") and draw(st.integers(0, 3)) == 0:
@@ -440,7 +441,7 @@ def command_lines(draw, command: str) -> list:
         tokens.append(option.name)
         if value is not None:
             tokens += value if isinstance(value, list) else [value]
-    if command == "list" and draw(st.booleans()):
+    if command in ("list", "info") and draw(st.booleans()):
         tokens.append(draw(st.sampled_from(["one-stage", "", "--set", "x=1"])))
     return tokens
 
@@ -494,8 +495,8 @@ COMMAND_NAMES = [
     "list" if c.__name__.endswith("listing") else c.__name__.rsplit(".", 1)[-1] for c in COMMANDS
 ]
 EXAMPLES = {
-    "list": 4, "new": 10, "run": 14, "modes": 10, "mesh": 10, "validate": 2, "sweep": 8, "sensitivity": 6,
-    "calibrate": 6, "render": 10,
+    "list": 4, "info": 2, "new": 10, "run": 14, "modes": 10, "mesh": 10, "validate": 2, "sweep": 8,
+    "sensitivity": 6, "calibrate": 6, "render": 10,
 }  # fmt: skip
 
 

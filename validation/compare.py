@@ -7,8 +7,13 @@ assembly code with gearbody) and compares the mesh forces on the common output g
 
 from __future__ import annotations
 
+import hashlib
+import json
+import os
+import sys
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -158,6 +163,7 @@ class CaseResult:
     wall_reference_s: float
     passed: bool
     note: str = ""
+    reference_cached: bool = False  # the reference's output came from the cache (cached_reference)
 
 
 def case_scenario(scene: str, case: Case, short: bool = False):
@@ -220,6 +226,7 @@ def compare_case(
     short: bool = False,
     tolerance_percent: float = 0.5,
     bearing_tolerance_percent: float = 1.0,
+    use_cache: bool = False,
 ) -> CaseResult:
     """Run gearbody and the reference on one case; the error is the worst stage's max |dF|/F_rated,s,
     and in lateral scenes also the worst bearing force's max error over its peak."""
@@ -233,12 +240,10 @@ def compare_case(
     res = simulate(scenario)
     t1 = time.perf_counter()
     if scenario.has_planetary:
-        from .reference.planetary_drive import simulate_reference_drive
-
-        ref = simulate_reference_drive(reference_input(scenario), t_eval=res.time_s)
+        from .reference.planetary_drive import simulate_reference_drive as reference
     else:
         reference = simulate_reference_lateral if scenario.is_lateral else simulate_reference
-        ref = reference(reference_input(scenario), t_eval=res.time_s)
+    ref, cached = cached_reference(reference, reference_input(scenario), res.time_s, use_cache)
     t2 = time.perf_counter()
     err = np.zeros_like(res.time_s)
     forces = []  # (gearbody, reference) mesh force signal names
@@ -276,6 +281,7 @@ def compare_case(
         t2 - t1,
         passed,
         note,
+        cached,
     )
 
 
@@ -284,10 +290,11 @@ def _stage_of(signal: str) -> int:
     return int(signal.split("_")[1]) - 1 if signal.startswith("stage_") else 0
 
 
-def _case_job(scene: str, case_name: str, short: bool, tolerance_percent: float) -> dict:
+def _case_job(scene: str, case_name: str, short: bool, tolerance_percent: float, use_cache: bool) -> dict:
     """One case as a job of gearbody's executors (a process pool): its CaseResult's fields."""
     case = next(c for c in cases(scene, short) if c.name == case_name)
-    return {"ok": True, "result": compare_case(scene, case, short, tolerance_percent).__dict__}
+    result = compare_case(scene, case, short, tolerance_percent, use_cache=use_cache)
+    return {"ok": True, "result": result.__dict__}
 
 
 def run_validation(
@@ -296,10 +303,12 @@ def run_validation(
     tolerance_percent: float = 0.5,
     echo=print,
     workers: int | None = 1,
+    use_cache: bool = False,
 ) -> bool:
     """Run every case of the given scenes, print a table (rows in case order), return True when all pass.
     ``workers``: cases run on that many local processes at once (None: one per CPU; 1: in this process,
-    one after the other). Each case's wall times are its own process's."""
+    one after the other). Each case's wall times are its own process's. ``use_cache``: take the reference's
+    output from :func:`cached_reference`'s cache where the reference and its inputs are unchanged."""
     from gearbody.studies.executors import run_jobs
 
     scenes = list(scenes or VALIDATED_SCENES)
@@ -308,13 +317,21 @@ def run_validation(
         "gearbody vs independent reference (scipy solve_ivp): max |dF|/F_rated, "
         f"tolerance {tolerance_percent} %; bearing forces: max |dF_b| / peak |F_b|, tolerance 1 %"
         + (" [short runs]" if short else "")
+        + (
+            "; 'cached': the reference's output of an unchanged reference and case, from the cache"
+            if use_cache
+            else ""
+        )
     )
     echo(
         f"{'scene':<22}{'case':<12}{'max dF %':>10}{'rms dF %':>10}{'bearing %':>11}{'K_d max':>9}{'sep.':>7}"
         f"{'gearbody s':>12}{'reference s':>13}  result"
     )
     results = []
-    jobs = [(str(i), (scene, case.name, short, tolerance_percent)) for i, (scene, case) in enumerate(todo)]
+    jobs = [
+        (str(i), (scene, case.name, short, tolerance_percent, use_cache))
+        for i, (scene, case) in enumerate(todo)
+    ]
     done: dict[int, CaseResult] = {}
     for jid, outcome in run_jobs(_case_job, jobs, workers=workers, name="gearbody-validate"):
         if not outcome["ok"]:
@@ -337,3 +354,63 @@ def _echo_row(echo, r: CaseResult) -> None:
         f"{r.separated_fraction:>7.2f}{r.wall_gearbody_s:>12.2f}{r.wall_reference_s:>13.2f}  "
         f"{'PASS' if r.passed else 'FAIL'} {r.note}"
     )
+
+
+CACHE_ENV = "GEARBODY_REFERENCE_CACHE"
+"""Folder of the reference's cached outputs (default ~/.cache/gearbody/reference)."""
+
+
+def cache_folder() -> Path:
+    """Where :func:`cached_reference` keeps the reference's outputs."""
+    default = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "gearbody" / "reference"
+    return Path(os.environ.get(CACHE_ENV, default))
+
+
+def reference_digest() -> str:
+    """SHA-256 of the reference's own source (every module of validation/reference and
+    validation/reference_lateral.py) and of the numpy, scipy and Python versions it runs on."""
+    here = Path(__file__).resolve().parent
+    h = hashlib.sha256()
+    for path in sorted([*(here / "reference").glob("*.py"), here / "reference_lateral.py"]):
+        h.update(path.name.encode())
+        h.update(path.read_bytes())
+    import scipy
+
+    h.update(f"numpy {np.__version__} scipy {scipy.__version__} python {sys.version}".encode())
+    return h.hexdigest()
+
+
+def cached_reference(reference, data: dict, t_eval: np.ndarray, use_cache: bool = True) -> tuple[dict, bool]:
+    """(``reference(data, t_eval=t_eval)``, whether it came from the cache). The output is kept in
+    :func:`cache_folder` under a key of the reference's source and versions (:func:`reference_digest`),
+    its function, ``data`` and ``t_eval``: a reference or an input that changed is run again; a cache
+    that cannot be read or written is passed over."""
+    if not use_cache:
+        return reference(data, t_eval=t_eval), False
+    h = hashlib.sha256(reference_digest().encode())
+    h.update(f"{reference.__module__}.{reference.__qualname__}".encode())
+    h.update(json.dumps(data, sort_keys=True, default=_jsonable).encode())
+    h.update(np.ascontiguousarray(t_eval, dtype=np.float64).tobytes())
+    path = cache_folder() / f"{h.hexdigest()}.npz"
+    try:
+        with np.load(path, allow_pickle=False) as stored:
+            return {k: stored[k] for k in stored.files}, True
+    except (OSError, ValueError, KeyError, EOFError):
+        pass
+    out = reference(data, t_eval=t_eval)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp.npz")
+        np.savez(tmp, **{k: np.asarray(v) for k, v in out.items()})
+        os.replace(tmp, path)
+    except (OSError, ValueError, TypeError):
+        pass
+    return out, False
+
+
+def _jsonable(value):
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} in the reference's input")

@@ -60,7 +60,7 @@ def label_peaks(
 ) -> list[LabelledPeak]:
     """Prominent local maxima of ``spectrum``, each labelled with the kinematic lines near it.
 
-    A peak is a local maximum (scipy.signal.find_peaks) whose amplitude is at least ``min_prominence_db``
+    A peak is a local maximum (scipy.signal.find_peaks's) whose amplitude is at least ``min_prominence_db``
     above the local floor, the median amplitude of the bins within +- ``floor_bins`` of it. Of those, the
     ``max_peaks`` most prominent are kept, returned in order of frequency. Bins 0 and 1 are not searched
     (DC and its leakage through the window). Each gets the labels of all
@@ -118,11 +118,9 @@ def _prominent_peaks(
     """``(peak bins, their prominence over the local floor [dB], the positions kept)``: the local maxima
     ``min_prominence_db`` over the median of +- ``floor_bins``, from bin 2 up to ``f_max_hz``; the
     ``max_peaks`` most prominent kept, in order of frequency."""
-    from scipy.ndimage import median_filter  # scipy.signal/ndimage: ~0.5 s to import, on use only
-    from scipy.signal import find_peaks
-
-    floor = median_filter(a, size=2 * floor_bins + 1, mode="reflect")
-    index, _ = find_peaks(a, height=floor * 10.0 ** (min_prominence_db / 20.0))
+    floor = running_median(a, 2 * floor_bins + 1)
+    index = local_maxima(a)
+    index = index[a[index] >= (floor * 10.0 ** (min_prominence_db / 20.0))[index]]
     index = index[index >= 2]  # bin 1 holds the window's leakage of the DC bin (the record's residual mean)
     if f_max_hz is not None:
         index = index[f[index] <= f_max_hz]
@@ -160,4 +158,32 @@ def _labelled(
                 offset_hz=float(distance_hz[near[0]]) if near.size else float("nan"),
             )
         )
+    return out
+
+
+def local_maxima(x: np.ndarray) -> np.ndarray:
+    """Indices of the local maxima of ``x`` as ``scipy.signal.find_peaks(x)`` finds them (without its
+    ~1 s import): a sample, or the middle of a run of equal samples (rounded down), higher than its
+    neighbours on both sides; never the first or the last sample."""
+    x = np.asarray(x, dtype=float)
+    if x.size < 3:
+        return np.zeros(0, dtype=np.intp)
+    starts = np.concatenate(([0], np.flatnonzero(x[1:] != x[:-1]) + 1))  # runs of equal samples
+    ends = np.concatenate((starts[1:] - 1, [x.size - 1]))
+    v = x[starts]
+    peak = np.zeros(starts.size, dtype=bool)
+    peak[1:-1] = (v[:-2] < v[1:-1]) & (v[2:] < v[1:-1])
+    return ((starts[peak] + ends[peak]) // 2).astype(np.intp)
+
+
+def running_median(x: np.ndarray, size: int, chunk: int = 1 << 15) -> np.ndarray:
+    """``scipy.ndimage.median_filter(x, size, mode="reflect")`` for an odd ``size`` (the same values: the
+    median of an odd count is one of the samples), in chunks of ``chunk`` outputs (bounded memory)."""
+    x = np.asarray(x, dtype=float)
+    half = size // 2
+    padded = np.pad(x, half, mode="symmetric")  # ndimage's "reflect": d c b a | a b c d | d c b a
+    windows = np.lib.stride_tricks.sliding_window_view(padded, size)
+    out = np.empty(x.size)
+    for i in range(0, x.size, chunk):
+        out[i : i + chunk] = np.median(windows[i : i + chunk], axis=-1)
     return out

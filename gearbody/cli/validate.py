@@ -27,6 +27,13 @@ def register(sub) -> argparse.ArgumentParser:
         default=None,
         help="cases run at once on this many local processes (default: one per CPU; 1: one after the other)",
     )
+    val.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="run the reference on every case (default: take its output from the cache where the "
+        "reference's code, its inputs and numpy/scipy are unchanged; $GEARBODY_REFERENCE_CACHE, "
+        "default ~/.cache/gearbody/reference)",
+    )
     val.set_defaults(handler=execute)
     return val
 
@@ -37,6 +44,10 @@ def execute(args) -> int:
     for scene in args.scenes:  # a misspelled scene fails before the table header
         load(scene, [])
     ok = run_validation(
-        args.scenes or None, short=args.short, tolerance_percent=args.tolerance, workers=args.workers
+        args.scenes or None,
+        short=args.short,
+        tolerance_percent=args.tolerance,
+        workers=args.workers,
+        use_cache=not args.no_cache,
     )
     return EXIT_OK if ok else EXIT_FAILED
