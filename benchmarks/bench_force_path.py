@@ -5,10 +5,11 @@ anti-aliasing so that every run is compared on exact samples): gearbody at the a
 default and tight on both force paths (``solver.force_path``), alternated in this process after a warm
 run; wall seconds of the solve per simulated second, steps, rejected steps, microseconds per step attempt
 and max |dF| / F_rated against a tight yardstick (rtol 1e-13, atol 1e-12, compiled path) over every mesh.
-Then, in fresh processes from benchmarks/bench_speed.py, Exudyn's floor (the same system with constant
-mesh stiffness and no user function), the numba Dormand-Prince loop (one-stage) and the independent scipy
-reference. Then a study of 64 one-stage cases on 2 local workers and on a local Dask cluster of 2 workers,
-on both paths, and the wall of ``gearbody run one-stage``.
+Then, in fresh processes (benchmarks/bench_speed.py's jobs), Exudyn's floor (the same system with constant
+mesh stiffness and no user function; planetary scenes: their linearised system), the numba Dormand-Prince
+loop (one-stage; the loop implements the torsional trains only) and the independent scipy reference.
+Then a study of 64 one-stage cases on 2 local workers and on a local Dask cluster of 2 workers, on both
+paths, and the wall of ``gearbody run one-stage``.
 
     python benchmarks/bench_force_path.py [--t-end 0.5] [--t-planetary 0.1] [--scenes ...] [--write]
 """
@@ -139,6 +140,46 @@ def bench_scene(scene: str, t_end: float) -> tuple[list[str], dict]:
     return lines, measured
 
 
+def _planetary_floor(scene: str, t_end: float):
+    """Exudyn alone on a planetary drive's bodies (fresh process): the linearised system (meshes as
+    constant stiffness matrices at their mean, compound_system(..., modal=True) with its constraints
+    kept), from the run's initial state, no user function. (wall s, steps, rejected)."""
+    import dataclasses
+
+    import exudyn as exu
+
+    from gearbody.assembly.compound import compound_layout
+    from gearbody.assembly.compound_system import compound_system
+    from gearbody.assembly.layouts import drive_system
+    from gearbody.engine.build import build
+    from gearbody.engine.simulate import SOLVER_TYPES, solver_settings
+    from gearbody.model import load_scenario
+
+    sc = load_scenario(scene, scene_overrides(scene, t_end))
+    _, q0, v0 = drive_system(sc)
+    linear = dataclasses.replace(compound_system(compound_layout(sc, modal=True), modal=True), modal=False)
+    built = build(linear, q0, v0)
+    t0 = time.perf_counter()
+    exu.SolveDynamic(
+        built.mbs, solver_settings(sc), solverType=SOLVER_TYPES[sc.solver.method], storeSolver=True
+    )
+    wall = time.perf_counter() - t0
+    it = built.mbs.sys["dynamicSolver"].it
+    return wall, int(it.currentStepIndex), int(it.rejectedAutomaticStepSizeSteps)
+
+
+def planetary_floor(scene: str, t_end: float) -> str:
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=1) as pool:
+        wall, steps, rej = pool.submit(_planetary_floor, scene, t_end).result()
+    print(f"  {scene} floor: {wall / t_end:.3f} s/s", flush=True)
+    return (
+        "| Exudyn floor: the same bodies, meshes as constant stiffness matrices (linearised), no user "
+        f"function | {wall / t_end:.3f} | {steps} | {rej} | {wall / max(steps + rej, 1) * 1e6:.2f} | - | |"
+    )
+
+
 def planetary_reference(scene: str, t_ref: float) -> str:
     from gearbody_validation.reference.planetary_drive import simulate_reference_drive
 
@@ -241,6 +282,7 @@ def main() -> None:
         print(scene, flush=True)
         block, m = bench_scene(scene, t_end)
         if scene in PLANETARY:
+            block.append(planetary_floor(scene, t_end))
             block.append(planetary_reference(scene, args.t_ref))
         lines += block + [""]
         c, p = m[("default", "compiled")], m[("default", "python")]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import EXIT_FAILED, EXIT_OK, load, number
+from .common import EXIT_FAILED, EXIT_OK, MAX_WORKERS, load, number
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -23,7 +23,7 @@ def register(sub) -> argparse.ArgumentParser:
     )
     val.add_argument(
         "--workers",
-        type=number(whole=True, ge=1),
+        type=number(whole=True, ge=1, le=MAX_WORKERS),
         default=None,
         help="cases run at once on this many local processes (default: one per CPU; 1: one after the other)",
     )
