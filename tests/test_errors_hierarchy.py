@@ -12,6 +12,8 @@ from gearbody.errors import GearbodyError
 NOT_ERRORS = {
     "gearbody.studies.runner.StudyInterrupted": "the user's Ctrl-C during a study: a KeyboardInterrupt "
     "(BaseException), so that no `except Exception` in between swallows it",
+    "gearbody.engine.compiled_path.PerformanceWarning": "a warning (gearbody runs, slower: the Python path), "
+    "issued with warnings.warn, never raised",
 }
 """Exception classes that are deliberately no GearbodyError, with the reason."""
 

@@ -33,7 +33,7 @@ from ..assembly.system import (
     SystemLayout,
     TorqueItem,
 )
-from ..errors import InputError
+from ..errors import GearbodyError, InputError
 
 __all__ = [
     "CompiledItem",
@@ -160,8 +160,9 @@ class CompiledItem:
         return int(native.calls(self.slot))
 
 
-class NotCompiled(Exception):
-    """An item (or one of its terms) has no compiled kernel; the message says which."""
+class NotCompiled(GearbodyError):
+    """An item (or one of its terms) has no compiled kernel; the message says which (caught by the builder,
+    which then puts the item on the Python path)."""
 
 
 def compiled_item(terms: list[tuple[object, np.ndarray]], size: int, watch=None) -> CompiledItem:
