@@ -216,3 +216,13 @@ def test_a_slot_is_released_with_its_system():
 
     layout, q0, v0 = drive_system(layout_sc)
     assert build(layout, q0, v0, force_path="compiled").force_path == "compiled"
+
+
+def test_the_command_line_says_it_once_in_one_line(no_extension, tmp_path, capsys):
+    from gearbody.cli import main
+
+    out = tmp_path / "run"
+    assert main(["run", "two-wheel", "--t-end", "0.01", "--out", str(out), "--quiet", "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    notes = [line for line in err.splitlines() if "through Python" in line]
+    assert len(notes) == 1 and notes[0].startswith("gearbody: note: ") and "build.py" not in err

@@ -99,6 +99,27 @@ def _printable_paths() -> None:
             pass
 
 
+@contextmanager
+def _notes_in_one_line() -> Iterator[None]:
+    """gearbody's PerformanceWarning (the force laws run through Python, slower) as one line on stderr,
+    ``gearbody: note: ...``, instead of Python's warning with a file and a source line."""
+    import warnings
+
+    previous = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if category.__name__ == "PerformanceWarning":
+            print(f"gearbody: note: {message}", file=sys.stderr)
+        else:
+            previous(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = previous
+
+
 def run() -> None:
     """The ``gearbody`` script and ``python -m gearbody.cli``: :func:`main`, then exit with its code. A
     process pool whose shutdown stuck (gearbody.studies.executors.STUCK_POOLS) would hold the
@@ -121,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
 
     _printable_paths()
     args = _parser().parse_args(argv)
-    with _sigterm_stops() as terminated:
+    with _sigterm_stops() as terminated, _notes_in_one_line():
         try:
             check_options(args)
             return args.handler(args)
