@@ -226,3 +226,18 @@ def test_the_command_line_says_it_once_in_one_line(no_extension, tmp_path, capsy
     err = capsys.readouterr().err
     notes = [line for line in err.splitlines() if "through Python" in line]
     assert len(notes) == 1 and notes[0].startswith("gearbody: note: ") and "build.py" not in err
+
+
+@needs_compiled
+def test_a_checkout_first_on_the_path_uses_the_installed_extension(tmp_path):
+    """The tests' command-line subprocesses put the checkout first on PYTHONPATH: with a plain install its
+    gearbody has no built extension, and loads the installed one (with an editable install it is there)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    code = "from gearbody.engine.compiled_path import compiled_path_status as s; print(s())"
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert out.stdout.strip() == "(True, '')", out.stdout + out.stderr

@@ -133,6 +133,7 @@ PYBIND11_MODULE(_force_entry, m) {
     m.doc() = "Compiled entries for Exudyn's force user functions (gearbody.engine.compiled_path)";
     define_entries(m, std::make_integer_sequence<int, SLOTS>{});
     m.attr("SLOTS") = SLOTS;
+    m.attr("ABI_VERSION") = 1;  // gearbody.engine.compiled_path.ABI_VERSION: the interface below
     m.def("acquire", &acquire, "A free slot (-1: none)");
     m.def("assign", &assign, py::arg("slot"), py::arg("size"), py::arg("kernels"), py::arg("parameters"),
           "Terms of a slot: cfunc addresses and the addresses of their float64 parameter arrays");

@@ -51,12 +51,59 @@ class PerformanceWarning(UserWarning):
     run has no compiled kernel)."""
 
 
+ABI_VERSION = 1
+"""The extension's interface (slots, assign, watch, ...) this module speaks: an extension of another
+version is not used."""
+
+
+@functools.cache
 def _native():
-    """The extension module, or the reason it is missing."""
+    """(the extension module, "") or (None, the reason it is missing). A checkout first on the path (tests'
+    subprocesses, ``python -m`` from the checkout root) has no built extension of its own: then the one
+    ``pip install`` built for the installed gearbody is loaded, if it speaks this ABI_VERSION."""
     try:
-        return importlib.import_module("gearbody.engine._force_entry"), ""
+        module = importlib.import_module("gearbody.engine._force_entry")
     except ImportError as exc:
-        return None, f"the extension gearbody.engine._force_entry is not built ({exc})"
+        module, why = (
+            _installed_extension(),
+            f"the extension gearbody.engine._force_entry is not built ({exc})",
+        )
+        if module is None:
+            return None, why
+    if getattr(module, "ABI_VERSION", None) != ABI_VERSION:
+        return None, (
+            f"the extension {module.__file__} speaks interface {getattr(module, 'ABI_VERSION', 0)}, this "
+            f"gearbody {ABI_VERSION} (reinstall gearbody)"
+        )
+    return module, ""
+
+
+def _installed_extension():
+    """The compiled extension of the installed gearbody distribution, loaded from its file, or None."""
+    import importlib.machinery
+    import importlib.metadata
+    import importlib.util
+    import sys
+
+    try:
+        files = importlib.metadata.distribution("gearbody").files or []
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    names = {f"_force_entry{suffix}" for suffix in importlib.machinery.EXTENSION_SUFFIXES}
+    for f in files:
+        if f.name in names and f.parent.as_posix().endswith("gearbody/engine"):
+            path = f.locate()
+            spec = importlib.util.spec_from_file_location("gearbody.engine._force_entry", path)
+            if spec is None or spec.loader is None:
+                return None
+            try:
+                module = importlib.util.module_from_spec(spec)
+                spec.loader.exec_module(module)
+            except ImportError:
+                return None
+            sys.modules["gearbody.engine._force_entry"] = module
+            return module
+    return None
 
 
 @functools.cache
