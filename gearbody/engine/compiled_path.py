@@ -79,28 +79,27 @@ def _native():
 
 
 def _installed_extension():
-    """The compiled extension of the installed gearbody distribution, loaded from its file, or None."""
+    """The compiled extension of an installed gearbody further down ``sys.path`` (a plain install's
+    site-packages), loaded from its file, or None."""
     import importlib.machinery
-    import importlib.metadata
     import importlib.util
     import sys
+    from pathlib import Path
 
-    try:
-        files = importlib.metadata.distribution("gearbody").files or []
-    except importlib.metadata.PackageNotFoundError:
-        return None
-    names = {f"_force_entry{suffix}" for suffix in importlib.machinery.EXTENSION_SUFFIXES}
-    for f in files:
-        if f.name in names and f.parent.as_posix().endswith("gearbody/engine"):
-            path = f.locate()
+    here = Path(__file__).resolve().parent
+    for entry in sys.path:
+        for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+            path = Path(entry or ".") / "gearbody" / "engine" / f"_force_entry{suffix}"
+            if not path.is_file() or path.resolve().parent == here:
+                continue
             spec = importlib.util.spec_from_file_location("gearbody.engine._force_entry", path)
             if spec is None or spec.loader is None:
-                return None
+                continue
             try:
                 module = importlib.util.module_from_spec(spec)
                 spec.loader.exec_module(module)
             except ImportError:
-                return None
+                continue
             sys.modules["gearbody.engine._force_entry"] = module
             return module
     return None
