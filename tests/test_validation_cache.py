@@ -62,3 +62,16 @@ def test_an_unreadable_cache_entry_is_run_again(cache):
 def test_the_digest_covers_the_reference_source():
     digest = compare.reference_digest()
     assert len(digest) == 64 and digest == compare.reference_digest()
+
+
+def test_the_table_says_which_reference_came_from_the_cache(cache):
+    rows = []
+    compare._echo_row(
+        rows.append, compare.CaseResult("s", "c", 0.1, 0.01, float("nan"), 1.2, 0.0, 1.0, 0.01, True)
+    )
+    compare._echo_row(
+        rows.append,
+        compare.CaseResult("s", "c", 0.1, 0.01, float("nan"), 1.2, 0.0, 1.0, 0.01, True, "", True),
+    )
+    assert "cached" not in rows[0] and "0.01" in rows[0]
+    assert rows[1].split()[-2] == "cached"

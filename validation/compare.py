@@ -351,7 +351,8 @@ def _echo_row(echo, r: CaseResult) -> None:
     echo(
         f"{r.scene:<22}{r.case:<12}{r.max_error_percent:>10.4f}{r.rms_error_percent:>10.4f}"
         f"{bearing:>11}{r.kd_max:>9.3f}"
-        f"{r.separated_fraction:>7.2f}{r.wall_gearbody_s:>12.2f}{r.wall_reference_s:>13.2f}  "
+        f"{r.separated_fraction:>7.2f}{r.wall_gearbody_s:>12.2f}"
+        f"{'cached' if r.reference_cached else f'{r.wall_reference_s:.2f}':>13}  "
         f"{'PASS' if r.passed else 'FAIL'} {r.note}"
     )
 
