@@ -168,6 +168,15 @@ class DriveItem:
     meshes: tuple[PairMesh, ...] = ()
     terms: tuple[SliceTerm, ...] = ()
 
+    def one_stage_mesh(self, coordinates: int) -> PairMesh | None:
+        """The mesh of a one-stage drive (motor, pinion, wheel, load at coordinates 0-3 of ``coordinates``
+        = 4, no slice terms), whose forces both force paths take from one fused law
+        (:func:`gearbody.physics.mesh.single_mesh_drive_forces`); None for any other drive."""
+        if self.terms or len(self.meshes) != 1 or coordinates != 4:
+            return None
+        m = self.meshes[0]
+        return m if (self.motor_at, m.pinion, m.wheel, self.load_at) == (0, 1, 2, 3) else None
+
 
 @dataclass(frozen=True)
 class SystemLayout:

@@ -73,7 +73,7 @@ def _native():
     if getattr(module, "ABI_VERSION", None) != ABI_VERSION:
         return None, (
             f"the extension {module.__file__} speaks interface {getattr(module, 'ABI_VERSION', 0)}, this "
-            f"gearbody {ABI_VERSION} (reinstall gearbody)"
+            f"gearbody interface {ABI_VERSION}"
         )
     return module, ""
 
@@ -267,10 +267,9 @@ def _item_bodies(item) -> tuple[int, ...]:
 
 
 def _drive_terms(item: DriveItem, size: int, K) -> list:
-    if not item.terms and len(item.meshes) == 1 and size == 4:
-        m = item.meshes[0]
-        if (item.motor_at, m.pinion, m.wheel, item.load_at) == (0, 1, 2, 3):
-            return [(K.single_mesh_drive_kernel, K.pack(m.parameters, item.drive))]
+    one_stage = item.one_stage_mesh(size)
+    if one_stage is not None:
+        return [(K.single_mesh_drive_kernel, K.pack(one_stage.parameters, item.drive))]
     terms = [
         (K.motor_kernel, K.pack([float(item.motor_at)], item.drive)),
         (K.load_kernel, K.pack([float(item.load_at)], item.drive)),

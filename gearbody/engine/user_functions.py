@@ -325,20 +325,19 @@ def drive_user_function(item: DriveItem, n: int, watchdog: StallWatchdog):
     (motor, pinion, wheel, load) calls one fused compiled law; a drive without slice terms works on
     Python lists, which is faster than numpy for a few coordinates."""
     D, im, il = item.drive, item.motor_at, item.load_at
-    if not item.terms and len(item.meshes) == 1 and n == 4:
-        m = item.meshes[0]
-        if (im, m.pinion, m.wheel, il) == (0, 1, 2, 3):
-            P = m.parameters
-            forces = compiled(single_mesh_drive_forces, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, P, D)
+    one_stage = item.one_stage_mesh(n)
+    if one_stage is not None:
+        P = one_stage.parameters
+        forces = compiled(single_mesh_drive_forces, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, P, D)
 
-            tick, check = watchdog.ticker()
+        tick, check = watchdog.ticker()
 
-            def drive_and_mesh(mbs, t, itemNumber, q, q_t):
-                if tick():
-                    check(t, q_t[0])
-                return forces(t, q_t[0], q[1], q[2], q_t[1], q_t[2], P, D)
+        def drive_and_mesh(mbs, t, itemNumber, q, q_t):
+            if tick():
+                check(t, q_t[0])
+            return forces(t, q_t[0], q[1], q[2], q_t[1], q_t[2], P, D)
 
-            return drive_and_mesh
+        return drive_and_mesh
     motor = compiled(motor_torque_at, 0.0, 0.0, D)
     load = compiled(load_torque_at, 0.0, D)
     meshes = [(m.pinion, m.wheel, m.parameters) for m in item.meshes]
