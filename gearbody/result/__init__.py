@@ -267,6 +267,22 @@ class Result:
 
         return evaluate_features(specs, self.record(natural_frequencies_hz))
 
+    def to_recording(self, channels=None, *, tacho_shaft: str = "pinion", pulses_per_rev: int = 1):
+        """The run as a :class:`gearbody.recording.Recording` (the container of measured signals):
+        ``channels`` (default every signal) in their units, the exact shaft angles as encoder channels,
+        and a virtual tacho of ``pulses_per_rev`` pulses per revolution of ``tacho_shaft``."""
+        from ..recording.from_run import recording_from_run
+
+        return recording_from_run(
+            self.time_s,
+            self.signals,
+            self.meta,
+            channels=channels,
+            tacho_shaft=tacho_shaft,
+            pulses_per_rev=pulses_per_rev,
+            vibration_signal=self.vibration_signal_name,
+        )
+
     def plot(self, out_dir: str | Path) -> list[Path]:
         """The run's standard PNGs in ``out_dir``: per parallel stage K_d over time and folded over the
         mesh period, the spectrum of the vibration signal, bearing forces (gearbody.plotting.run); per
