@@ -1,5 +1,5 @@
-"""Command line: ``gearbody list | new | run | modes | mesh | validate | sweep | sensitivity | calibrate |
-render | info``.
+"""Command line: ``gearbody list | new | run | analyze | compare | modes | mesh | validate | sweep |
+sensitivity | calibrate | render | info``.
 
 One module per command (``register(sub)`` adds its parser, ``execute(args)`` runs it; heavy imports
 happen inside ``execute``), the shared options and exit codes in :mod:`.common`. Exit codes: 0 ok,
@@ -28,7 +28,21 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from . import calibrate, info, listing, mesh, modes, new, render, run, sensitivity, sweep, validate
+from . import (
+    analyze,
+    calibrate,
+    compare,
+    info,
+    listing,
+    mesh,
+    modes,
+    new,
+    render,
+    run,
+    sensitivity,
+    sweep,
+    validate,
+)
 from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_TERMINATED
 
 __all__ = ["main"]
@@ -44,10 +58,26 @@ EPILOG = """examples:
   gearbody validate one-stage
   gearbody render industrial-two-stage --frames 100 --out runs/pictures
   gearbody render one-stage --result runs/one-stage --view front --frame gears
+  gearbody analyze logger.wav --scene one-stage --tacho tacho --out runs/measured
+  gearbody compare runs/one-stage logger.wav --scene one-stage --tacho tacho
   gearbody info                                  (versions, and whether the force laws run compiled)
 """
 
-COMMANDS = (listing, new, run, modes, mesh, validate, sweep, sensitivity, calibrate, render, info)
+COMMANDS = (
+    listing,
+    new,
+    run,
+    analyze,
+    compare,
+    modes,
+    mesh,
+    validate,
+    sweep,
+    sensitivity,
+    calibrate,
+    render,
+    info,
+)
 """In the order of ``gearbody --help``."""
 
 

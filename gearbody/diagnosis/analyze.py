@@ -1,0 +1,196 @@
+"""One recording, the analysis a simulated run gets: per channel the labelled spectrum in Hz and in
+orders, synchronous averages of every gear's shaft with the condition indicators, the fault bands, the
+kurtogram's band and the envelope spectrum in it with the bearing lines, and cepstral peaks of the shaft
+families. A :class:`Diagnosis` holds it all; ``features()`` flattens it into named numbers (what
+``gearbody compare`` sets side by side and what calibration can take as targets)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..analysis import Spectrum, amplitude_spectrum, condition_indicators_from_average, label_peaks
+from ..errors import InputError
+from ..recording import Recording
+from .bands import BandMetric, band_metrics
+from .drive import DriveKinematics
+from .speed import ShaftAngles, shaft_angles
+
+__all__ = ["ChannelDiagnosis", "Diagnosis", "analyze_recording"]
+
+MIN_TSA_REVOLUTIONS = 3
+HARMONICS = 6
+
+
+@dataclass
+class ChannelDiagnosis:
+    """What one channel shows (amplitudes in the channel's SI unit)."""
+
+    name: str
+    unit: str
+    spectrum: Spectrum
+    peaks: list
+    order_spectrum: Spectrum | None = None
+    """Amplitude over orders of the input shaft (``frequency_hz`` holds orders)."""
+    order_peaks: list = field(default_factory=list)
+    averages: dict[str, Any] = field(default_factory=dict)
+    """Body -> SynchronousAverage of the channel over that body's revolutions."""
+    indicators: dict[str, dict[str, float]] = field(default_factory=dict)
+    bands: list[BandMetric] = field(default_factory=list)
+    kurtogram: Any = None
+    envelope: Any = None
+    envelope_peaks: list = field(default_factory=list)
+    envelope_bands: list[BandMetric] = field(default_factory=list)
+    cepstral_peaks: dict[str, float] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    def envelope_spectrum(self) -> Spectrum | None:
+        """The envelope spectrum as a :class:`Spectrum` (None when not computed)."""
+        if self.envelope is None:
+            return None
+        return Spectrum(
+            frequency_hz=np.asarray(self.envelope.frequency_hz), amplitude=np.asarray(self.envelope.amplitude)
+        )
+
+    def features(self) -> dict[str, float]:
+        """Named numbers: ``rms``, ``kurtosis``, ``crest_factor`` of the channel; ``<indicator>:<body>``;
+        ``band_peak:<line>`` and ``band_power:<line>`` (order domain); ``envelope_peak:<line>``;
+        ``cepstrum:<body>``."""
+        from ..analysis import crest_factor, kurtosis, rms
+
+        x = self._signal
+        out = {"rms": rms(x), "kurtosis": kurtosis(x), "crest_factor": crest_factor(x)}
+        for body, values in self.indicators.items():
+            out.update({f"{k}:{body}": v for k, v in values.items()})
+        for b in self.bands:
+            out[f"band_peak:{b.label}"] = b.peak_amplitude
+            out[f"band_power:{b.label}"] = b.band_power
+        for b in self.envelope_bands:
+            out[f"envelope_peak:{b.label}"] = b.peak_amplitude
+        out.update({f"cepstrum:{body}": v for body, v in self.cepstral_peaks.items()})
+        return {k: float(v) for k, v in out.items()}
+
+    _signal: np.ndarray = field(default=None, repr=False)
+
+
+@dataclass
+class Diagnosis:
+    """The analysis of a recording of a drive: its shaft angles and one :class:`ChannelDiagnosis` per
+    analysed channel."""
+
+    recording: Recording
+    drive: DriveKinematics
+    angles: ShaftAngles
+    channels: dict[str, ChannelDiagnosis]
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def mean_input_hz(self) -> float:
+        return self.angles.mean_input_hz()
+
+    def features(self) -> dict[str, float]:
+        """Every channel's features as ``<channel>/<feature>``, plus ``input_speed_hz``."""
+        out = {"input_speed_hz": self.mean_input_hz}
+        for name, ch in self.channels.items():
+            out.update({f"{name}/{k}": v for k, v in ch.features().items()})
+        return out
+
+
+def analyze_recording(
+    recording: Recording,
+    drive: DriveKinematics,
+    channels: Sequence[str] | None = None,
+    *,
+    envelope: bool = True,
+    kurtogram_level: int = 6,
+) -> Diagnosis:
+    """The :class:`Diagnosis` of ``channels`` (default: the recording's vibration channels, at most 4)
+    with the drive's kinematics ``drive`` (:meth:`DriveKinematics.from_scenario`)."""
+    names = list(channels) if channels else recording.vibration_channels[:4]
+    if not names:
+        raise InputError(f"the recording has no vibration channel; channels: {', '.join(recording.names)}")
+    for name in names:
+        recording.channel(name)  # a SignalError naming the channels there are
+    angles = shaft_angles(recording, drive)
+    diag = Diagnosis(recording, drive, angles, {})
+    if angles.note:
+        diag.notes.append(angles.note)
+    for name in names:
+        diag.channels[name] = _channel(recording, name, angles, envelope, kurtogram_level)
+    return diag
+
+
+def _channel(recording: Recording, name: str, angles: ShaftAngles, envelope: bool, level: int):
+    ch = recording.channel(name)
+    x, fs, drive = ch.data, recording.sample_rate_hz, angles.drive
+    f_in = angles.mean_input_hz()
+    spec = amplitude_spectrum(x, fs, window="hann")
+    f_top = max((abs(drive.speed_ratios[g.body]) * g.teeth for g in drive.gears if g.teeth), default=1.0)
+    f_max = min(fs / 2, (HARMONICS + 0.5) * f_top * f_in)
+    lines_hz = drive.lines(f_in, f_max)
+    peaks = label_peaks(spec, lines_hz, min_prominence_db=12.0, max_peaks=40, f_max_hz=f_max)
+    out = ChannelDiagnosis(name, ch.unit, spec, peaks, _signal=x)
+    _orders(out, x, fs, angles, f_max / f_in)
+    _averages(out, x, angles)
+    if envelope:
+        _envelope(out, x, fs, angles, level)
+    return out
+
+
+def _orders(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, max_order: float) -> None:
+    from ..analysis.orders import order_spectrum, order_track
+
+    revs = (angles.input_angle_rad[-1] - angles.input_angle_rad[0]) / (2 * np.pi)
+    if revs < MIN_TSA_REVOLUTIONS:
+        out.notes.append(f"no order spectrum: the input shaft turns {revs:.1f} revolutions (needs 3)")
+        return
+    tracked = order_track(x, fs, angles.input_angle_rad, max_order=max_order)
+    ospec = order_spectrum(tracked)
+    spec = Spectrum(frequency_hz=np.asarray(ospec.orders), amplitude=np.asarray(ospec.amplitude))
+    lines = angles.drive.lines(1.0, float(spec.frequency_hz[-1]))
+    out.order_spectrum = spec
+    out.order_peaks = label_peaks(spec, lines, min_prominence_db=12.0, max_peaks=40, f_max_hz=max_order)
+    out.bands = band_metrics(spec, lines)
+
+
+def _averages(out: ChannelDiagnosis, x, angles: ShaftAngles) -> None:
+    from ..analysis import synchronous_average
+
+    for gear in angles.drive.gears:
+        angle = angles.of(gear.body)
+        revs = (angle[-1] - angle[0]) / (2 * np.pi)
+        if revs < MIN_TSA_REVOLUTIONS or gear.teeth is None:
+            out.notes.append(f"no synchronous average of {gear.body}: {revs:.1f} revolutions (needs 3)")
+            continue
+        tsa = synchronous_average(x, angle, teeth=gear.teeth)
+        out.averages[gear.body] = tsa
+        out.indicators[gear.body] = condition_indicators_from_average(tsa).as_dict()
+        out.cepstral_peaks[gear.body] = _cepstral(x, angles, gear.body)
+
+
+def _cepstral(x, angles: ShaftAngles, body: str) -> float:
+    from ..analysis.cepstrum import cepstral_peak
+
+    fs = 1.0 / float(angles.time_s[1] - angles.time_s[0])
+    shaft_hz = angles.mean_input_hz() * abs(angles.drive.ratio(body, angles.drive.input_body))
+    return float(cepstral_peak(x, fs, shaft_hz))
+
+
+def _envelope(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, level: int) -> None:
+    from ..analysis.envelope import envelope_spectrum
+    from ..analysis.kurtogram import fast_kurtogram
+
+    kurt = fast_kurtogram(x, fs, max_level=level)
+    out.kurtogram = kurt
+    band = (kurt.centre_hz - kurt.bandwidth_hz / 2, kurt.centre_hz + kurt.bandwidth_hz / 2)
+    f_in = angles.mean_input_hz()
+    env = envelope_spectrum(x, fs, band_hz=band, convention="squared")
+    out.envelope = env
+    spec = Spectrum(frequency_hz=np.asarray(env.frequency_hz), amplitude=np.asarray(env.amplitude))
+    f_max = min(float(spec.frequency_hz[-1]), kurt.bandwidth_hz / 2)
+    lines = angles.drive.lines(f_in, f_max)
+    out.envelope_peaks = label_peaks(spec, lines, min_prominence_db=12.0, max_peaks=20, f_max_hz=f_max)
+    out.envelope_bands = band_metrics(spec, lines, families=("bearing",))
