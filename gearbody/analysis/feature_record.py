@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -55,6 +56,9 @@ class Record:
     wheel_teeth: int | None = None
     period_boundaries_s: tuple[float, ...] = ()
     natural_frequencies_hz: tuple[float, ...] = ()
+    meta: Mapping[str, Any] = field(default_factory=dict)
+    """What the record came from (a run's ``scenario`` and ``vibration_signal``), for features that
+    analyse it as its drive (:mod:`gearbody.diagnosis.features`)."""
 
     def __post_init__(self) -> None:
         t = np.asarray(self.time_s, dtype=float)

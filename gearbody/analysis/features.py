@@ -151,7 +151,7 @@ def parse_feature(text: str) -> FeatureSpec:
 
 
 _INT_OPTIONS = ("period", "stage", "planet", "mesh", "order", "mode")
-_STR_OPTIONS = ("signal", "shaft", "gear")
+_STR_OPTIONS = ("signal", "shaft", "gear", "feature")
 
 
 def _option_value(text: str, key: str, value: str, name: str = "") -> float | str:

@@ -258,6 +258,9 @@ class Result:
             wheel_teeth=teeth[1],
             period_boundaries_s=self.period_boundaries_s(),
             natural_frequencies_hz=tuple(float(f) for f in natural_frequencies_hz),
+            meta={"scenario": self.meta.get("scenario"), "vibration_signal": self.vibration_signal_name}
+            if self.meta.get("scenario")
+            else {},
         )
 
     def features(self, specs, natural_frequencies_hz=()) -> dict[str, float]:
