@@ -76,6 +76,21 @@ def register(sub) -> argparse.ArgumentParser:
         "uncertainty in the feature's unit; repeatable",
     )
     ca.add_argument(
+        "--target-from",
+        action="append",
+        nargs=3,
+        default=[],
+        metavar=("FEATURES", "KEY", "SIGMA"),
+        help="a target from a recording: feature KEY ('<channel>/<feature>' or '<feature>') of the "
+        "features.json 'gearbody analyze' wrote (FEATURES: the file or its folder), computed on each run "
+        "by the same analysis of --target-signal; repeatable",
+    )
+    ca.add_argument(
+        "--target-signal",
+        metavar="SIGNAL",
+        help="the run's signal the --target-from features are computed on (default: its vibration signal)",
+    )
+    ca.add_argument(
         "--case",
         action="append",
         nargs=2,
@@ -133,6 +148,16 @@ def _starts(texts: list[str]) -> dict[str, float]:
     return starts
 
 
+def _recording_target(path: str, key: str, sigma: str, signal: str | None):
+    """--target-from FEATURES KEY SIGMA: the 'recording' feature of KEY with the value the file holds."""
+    from gearbody.diagnosis.features import target_from_features
+    from gearbody.studies.scene_calibration import parse_target
+
+    feature, value = target_from_features(path, key)
+    spec = f"recording:feature={feature}" + (f",signal={signal}" if signal else "")
+    return parse_target(spec, repr(value), sigma)
+
+
 def execute(args) -> int:
     from gearbody.studies import SweepSpecError
     from gearbody.studies.scene_calibration import calibrate_scene, parse_parameter, parse_target
@@ -147,6 +172,7 @@ def execute(args) -> int:
         if starts:
             raise SweepSpecError(f"--start {next(iter(starts))}: not a --param key")
         targets = [parse_target(*t) for t in args.target]
+        targets += [_recording_target(*t, args.target_signal) for t in args.target_from]
         cases: dict[str, list[str]] = {}
         for name, override in args.case:
             cases.setdefault(name, []).append(override)

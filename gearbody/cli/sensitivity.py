@@ -58,6 +58,16 @@ def register(sub) -> argparse.ArgumentParser:
         metavar="SPEC",
         help="a feature spec (docs/features.md), e.g. kd_max:period=4; repeatable",
     )
+    se.add_argument(
+        "--target-from",
+        action="append",
+        nargs=3,
+        default=[],
+        metavar=("FEATURES", "KEY", "SIGMA"),
+        help="a recording's feature as target: the output is the run's misfit (value - target) / SIGMA of "
+        "feature KEY of the features.json 'gearbody analyze' wrote (FEATURES: the file or its folder), "
+        "computed on each run by the same analysis of its vibration signal; repeatable",
+    )
     se.add_argument("--method", choices=("morris", "sobol"), default="morris", help="default morris")
     se.add_argument(
         "--samples",
@@ -102,10 +112,16 @@ def execute(args) -> int:
 
     check_out(args.out)
     try:
+        features = list(args.feature)
+        for path, key, sigma in args.target_from:
+            from gearbody.diagnosis.features import target_from_features
+
+            feature, value = target_from_features(path, key)
+            features.append(f"recording:feature={feature},target={value!r},sigma={sigma}")
         res = sensitivity(
             args.scene,
             args.key,
-            args.feature,
+            features,
             out=args.out,
             method=args.method,
             samples=args.samples,

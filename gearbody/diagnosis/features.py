@@ -4,7 +4,9 @@ a run the same way, so calibration and sensitivity take a recording's features a
 
 ``recording:feature=fm4:pinion,signal=pinion_housing_accel_y_m_s2`` analyses ``signal`` (default: the run's
 vibration signal) over the feature's window (default the final quarter) with the run's scenario, its exact
-input-shaft angle as the tacho. Registering happens on import (the studies import this module)."""
+input-shaft angle as the tacho; with ``target=V,sigma=S`` its value is the misfit (value - V) / S (a
+recording's feature as the target of a sensitivity analysis). Registering happens on import (the
+studies import this module)."""
 
 from __future__ import annotations
 
@@ -60,6 +62,11 @@ def recording_feature_value(spec, record, names: tuple[str, ...], mask) -> float
     if feature not in values:
         shown = ", ".join(sorted(values)[:30])
         raise FeatureError(f"feature {spec}: the analysis gives no {feature!r}; it gives {shown}, ...")
+    if "target" in spec.options:  # the misfit to a recording's value, in its sigmas
+        sigma = float(spec.options.get("sigma", 1.0))
+        if not sigma > 0:
+            raise FeatureError(f"feature {spec}: sigma = {sigma:g} must be > 0")
+        return (float(values[feature]) - float(spec.options["target"])) / sigma
     return float(values[feature])
 
 
@@ -85,6 +92,8 @@ def target_from_features(path: str | Path, key: str) -> tuple[str, float]:
 register_feature(
     NAME,
     FeatureKind(
-        options=("feature", "signal", *WINDOW_OPTIONS), signals=_signals, value=recording_feature_value
+        options=("feature", "signal", "target", "sigma", *WINDOW_OPTIONS),
+        signals=_signals,
+        value=recording_feature_value,
     ),
 )
