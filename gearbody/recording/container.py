@@ -158,6 +158,22 @@ class Recording:
         chans = [ch.with_data(ch.data[lo:hi]) for ch in self.channels.values()]
         return Recording(self.sample_rate_hz, chans, float(t[lo]), self.tacho, dict(self.meta))
 
+    def as_quantity(self, name: str, quantity: str, f_low_hz: float | None = None) -> Channel:
+        """Channel ``name`` (acceleration, velocity or displacement) as ``quantity`` (integrated or
+        differentiated in the frequency domain; ``f_low_hz``: the high-pass an integration needs), named
+        ``<name>_<quantity>``."""
+        from ..analysis.integration import change_quantity
+
+        ch = self.channel(name)
+        units = {"displacement": "m", "velocity": "m/s", "acceleration": "m/s^2"}
+        if ch.quantity not in units:
+            raise InputError(
+                f"channel {name!r} holds {ch.quantity or 'a dimensionless quantity'} ({ch.unit!r}); only "
+                "acceleration, velocity and displacement convert"
+            )
+        data = change_quantity(ch.data, self.sample_rate_hz, ch.quantity, quantity, f_low_hz)
+        return Channel(f"{name}_{quantity}", data, units[quantity], 1.0, ch.location, ch.direction, ch.shaft)
+
     def with_channels(self, *channels: Channel) -> Recording:
         """This recording with ``channels`` added (or replacing those of the same name)."""
         merged = dict(self.channels)
