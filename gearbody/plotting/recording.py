@@ -89,14 +89,16 @@ def kurtogram_figure(kurtogram, title: str) -> Figure:
     k = np.asarray(kurtogram.kurtosis)
     fs = float(kurtogram.sample_rate_hz)
     levels = np.asarray(kurtogram.levels, dtype=float)
+    rows = np.arange(levels.size)
     image = ax.imshow(
         np.clip(k, 0, None),
         aspect="auto",
         origin="upper",
         cmap="viridis",
         interpolation="nearest",
-        extent=(0, fs / 2, levels[-1] + 0.25, levels[0] - 0.25),
+        extent=(0, fs / 2, rows[-1] + 0.5, -0.5),
     )
+    ax.set_yticks(rows, [f"{lv:.1f}" for lv in levels])
     fig.colorbar(image, ax=ax, label="spectral kurtosis")
     lo = kurtogram.centre_hz - kurtogram.bandwidth_hz / 2
     ax.axvspan(lo, lo + kurtogram.bandwidth_hz, color="red", alpha=0.25, lw=0)

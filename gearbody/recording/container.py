@@ -118,11 +118,17 @@ class Recording:
         return self._vibration_channels()
 
     def _vibration_channels(self) -> list[str]:
+        tacho = self.tacho.channel if self.tacho is not None else ""
         for quantity in ("acceleration", "velocity", "displacement", "force"):
-            found = self.channels_of(quantity)
+            found = [n for n in self.channels_of(quantity) if n != tacho]
             if found:
                 return found
-        return [n for n, ch in self.channels.items() if ch.quantity not in ("angle", "angular velocity")]
+        tacho = self.tacho.channel if self.tacho is not None else ""
+        return [
+            n
+            for n, ch in self.channels.items()
+            if ch.quantity not in ("angle", "angular velocity") and n != tacho
+        ]
 
     def describe(self) -> dict[str, Any]:
         """Everything but the samples: rate, start, length, channels, tacho, metadata."""
