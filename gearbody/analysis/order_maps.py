@@ -20,7 +20,6 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import InputError
 from ._validate import integer_at_least, is_real
 from .orders import OrderTrackedSignal, order_track
-from .spectrum import periodic_window
 
 __all__ = [
     "SLICE_KAISER_BETA",
@@ -67,7 +66,9 @@ def _block_amplitudes(
 ) -> NDArray[np.float64]:
     """Single-sided peak amplitude of every block (rows) [signal units]."""
     blocks = sliding_window_view(values, points)[::hop]
-    w = periodic_window(window, points)
+    from scipy.signal import get_window
+
+    w = get_window(window, points, fftbins=True)
     scale = 2.0 / np.sum(w)
     rows = []
     per_batch = max(1, _BATCH_POINTS // points)
