@@ -25,6 +25,13 @@ MIN_TSA_REVOLUTIONS = 3
 HARMONICS = 6
 
 
+def axis_spectrum(axis, amplitude, window: str) -> Spectrum:
+    """A :class:`Spectrum` on a uniform ``axis`` from 0 (Hz, or orders), its resolution the axis step."""
+    axis = np.asarray(axis, dtype=float)
+    n = 2 * (axis.size - 1)
+    return Spectrum(axis, np.asarray(amplitude, dtype=float), float(axis[1] - axis[0]) * n, str(window), n)
+
+
 @dataclass
 class ChannelDiagnosis:
     """What one channel shows (amplitudes in the channel's SI unit)."""
@@ -51,9 +58,7 @@ class ChannelDiagnosis:
         """The envelope spectrum as a :class:`Spectrum` (None when not computed)."""
         if self.envelope is None:
             return None
-        return Spectrum(
-            frequency_hz=np.asarray(self.envelope.frequency_hz), amplitude=np.asarray(self.envelope.amplitude)
-        )
+        return axis_spectrum(self.envelope.frequency_hz, self.envelope.amplitude, self.envelope.window)
 
     def features(self) -> dict[str, float]:
         """Named numbers: ``rms``, ``kurtosis``, ``crest_factor`` of the channel; ``<indicator>:<body>``;
@@ -141,7 +146,8 @@ def _channel(recording: Recording, name: str, angles: ShaftAngles, envelope: boo
 
 
 def _orders(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, max_order: float) -> None:
-    from ..analysis.orders import order_spectrum, order_track
+    from ..analysis.order_maps import order_spectrum
+    from ..analysis.orders import order_track
 
     revs = (angles.input_angle_rad[-1] - angles.input_angle_rad[0]) / (2 * np.pi)
     if revs < MIN_TSA_REVOLUTIONS:
@@ -149,7 +155,7 @@ def _orders(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, max_order: float)
         return
     tracked = order_track(x, fs, angles.input_angle_rad, max_order=max_order)
     ospec = order_spectrum(tracked)
-    spec = Spectrum(frequency_hz=np.asarray(ospec.orders), amplitude=np.asarray(ospec.amplitude))
+    spec = axis_spectrum(ospec.order, ospec.amplitude, ospec.window)
     lines = angles.drive.lines(1.0, float(spec.frequency_hz[-1]))
     out.order_spectrum = spec
     out.order_peaks = label_peaks(spec, lines, min_prominence_db=12.0, max_peaks=40, f_max_hz=max_order)
@@ -176,20 +182,41 @@ def _cepstral(x, angles: ShaftAngles, body: str) -> float:
 
     fs = 1.0 / float(angles.time_s[1] - angles.time_s[0])
     shaft_hz = angles.mean_input_hz() * abs(angles.drive.ratio(body, angles.drive.input_body))
-    return float(cepstral_peak(x, fs, shaft_hz))
+    return float(cepstral_peak(x, fs, shaft_hz).prominence)
+
+
+USABLE_BAND = 0.8
+"""Share of the Nyquist band the kurtogram may choose from: a logger's anti-alias filter (and a run's
+band-limited output) leave the top of the band to filter edges, whose ringing a kurtogram would pick."""
+
+
+def _within(kurt, fs: float):
+    """``kurt`` with its best band chosen among the bands below :data:`USABLE_BAND` of the Nyquist band."""
+    from dataclasses import replace
+
+    best = (-np.inf, kurt.level, kurt.centre_hz, kurt.bandwidth_hz)
+    for row, level in enumerate(kurt.levels):
+        centres, values = kurt.band_values(row)
+        width = fs / 2 / kurt.n_bands[row]
+        for centre, value in zip(centres, values, strict=True):
+            if centre + width / 2 <= USABLE_BAND * fs / 2 + 1e-9 and value > best[0]:
+                best = (float(value), float(level), float(centre), float(width))
+    if not np.isfinite(best[0]):
+        return kurt
+    return replace(kurt, max_kurtosis=best[0], level=best[1], centre_hz=best[2], bandwidth_hz=best[3])
 
 
 def _envelope(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, level: int) -> None:
     from ..analysis.envelope import envelope_spectrum
     from ..analysis.kurtogram import fast_kurtogram
 
-    kurt = fast_kurtogram(x, fs, max_level=level)
+    kurt = _within(fast_kurtogram(x, fs, max_level=min(level, max(1, int(np.log2(x.size)) - 7))), fs)
     out.kurtogram = kurt
-    band = (kurt.centre_hz - kurt.bandwidth_hz / 2, kurt.centre_hz + kurt.bandwidth_hz / 2)
+    band = kurt.band_hz
     f_in = angles.mean_input_hz()
     env = envelope_spectrum(x, fs, band_hz=band, convention="squared")
     out.envelope = env
-    spec = Spectrum(frequency_hz=np.asarray(env.frequency_hz), amplitude=np.asarray(env.amplitude))
+    spec = axis_spectrum(env.frequency_hz, env.amplitude, env.window)
     f_max = min(float(spec.frequency_hz[-1]), kurt.bandwidth_hz / 2)
     lines = angles.drive.lines(f_in, f_max)
     out.envelope_peaks = label_peaks(spec, lines, min_prominence_db=12.0, max_peaks=20, f_max_hz=f_max)

@@ -84,6 +84,12 @@ def _tacholess(recording: Recording, drive: DriveKinematics) -> ShaftAngles:
         )
     ratio = abs(drive.ratio(gear.body, drive.input_body))
     channel = recording.vibration_channels[0]
-    found = tacholess_angle(recording[channel], recording.sample_rate_hz, gear.teeth, float(speed) * ratio)
+    found = tacholess_angle(
+        recording[channel],
+        recording.sample_rate_hz,
+        gear.teeth,
+        speed_guess_hz=float(speed) * ratio,
+        t0_s=recording.t0_s,
+    )
     note = f"tacholess: shaft angle from the {gear.teeth}x mesh harmonic of {gear.body} on {channel!r}"
     return ShaftAngles(recording.time_s, np.asarray(found.angle_rad) / ratio, drive, "tacholess", note)

@@ -40,7 +40,7 @@ def reduced(spectrum, x_max: float):
         groups = a[:n].reshape(-1, step)
         k = np.argmax(groups, axis=1) + np.arange(groups.shape[0]) * step
         f, a = f[k], a[k]
-    return Spectrum(frequency_hz=f, amplitude=a)
+    return Spectrum(f, a, spectrum.sample_rate_hz, spectrum.window, spectrum.n_samples)
 
 
 def order_spectrum_figure(spec, peaks, title: str, unit: str, max_order: float) -> Figure:
@@ -73,11 +73,15 @@ def shaft_tsa_figure(tsa, channel: str, body: str, unit: str = "") -> Figure:
 
 def envelope_figure(spec, peaks, title: str, unit: str, f_max_hz: float) -> Figure:
     """The envelope spectrum with its labelled peaks (bearing lines, shaft orders)."""
+    from dataclasses import replace
+
     fig = new_figure((1100, 450), 100)
     ax = fig.add_subplot(1, 1, 1)
-    plot_labelled_spectrum(
-        reduced(spec, f_max_hz), peaks, ax=ax, title=title, unit=unit, f_max_hz=f_max_hz, log=False
-    )
+    spec = reduced(spec, f_max_hz)
+    amplitude = spec.amplitude.copy()
+    amplitude[:2] = np.nan  # the mean (DC) and its leakage through the window would hide every line
+    spec = replace(spec, amplitude=amplitude)
+    plot_labelled_spectrum(spec, peaks, ax=ax, title=title, unit=unit, f_max_hz=f_max_hz, log=False)
     ax.set_xlabel("envelope frequency [Hz]")
     return fig
 

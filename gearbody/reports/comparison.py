@@ -4,11 +4,12 @@ labelled with the drive's lines), and overlay_orders.png."""
 from __future__ import annotations
 
 import html
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from gearbody.analysis import Spectrum
+from gearbody.analysis import Spectrum  # noqa: F401 (the type of what _normalised takes)
 from gearbody.folders import atomic_write, write_text
 from gearbody.plotting.figure import png_base64, save_figure
 from gearbody.plotting.recording import overlay_figure
@@ -21,7 +22,7 @@ __all__ = ["write_comparison"]
 
 def _normalised(spec: Spectrum) -> Spectrum:
     top = float(np.max(spec.amplitude[1:])) if spec.amplitude.size > 1 else 1.0
-    return Spectrum(frequency_hz=spec.frequency_hz, amplitude=spec.amplitude / (top or 1.0))
+    return replace(spec, amplitude=spec.amplitude / (top or 1.0))
 
 
 def write_comparison(comparison, out: str | Path, title: str) -> list[Path]:
