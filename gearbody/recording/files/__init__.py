@@ -131,14 +131,14 @@ def read_recording(
             raise InputError(
                 f"{path}: {key}= cannot be used with format {fmt.name!r} (its own options: {allowed})"
             )
-    _check_common(channels, units, tacho_channel, pulses_per_rev, tacho_shaft)
-    if not path.is_file():
-        raise InputError(f"{path}: no such file" if not path.exists() else f"{path}: not a file")
-    if path.stat().st_size == 0:
-        raise InputError(f"{path}: the file is empty (0 bytes)")
-    req = ReadRequest(path, fmt.name, sample_rate_hz, channels, units, calibration, tacho_channel,
-                      start_s, end_s)  # fmt: skip
     try:
+        _check_common(channels, units, tacho_channel, pulses_per_rev, tacho_shaft)
+        if not path.is_file():
+            raise InputError(f"{path}: no such file" if not path.exists() else f"{path}: not a file")
+        if path.stat().st_size == 0:
+            raise InputError(f"{path}: the file is empty (0 bytes)")
+        req = ReadRequest(path, fmt.name, sample_rate_hz, channels, units, calibration, tacho_channel,
+                          start_s, end_s)  # fmt: skip
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the libraries' warnings on chunks they skip
             recording = _module(fmt).read(path, req)
