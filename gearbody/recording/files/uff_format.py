@@ -111,6 +111,10 @@ def read(path: Path, req: ReadRequest) -> Recording:
         if len(chans) != len(desc["channels"]):
             raise InputError(f"the file holds {len(chans)} records, its description {len(desc['channels'])}")
         return own_recording(desc, lambda i, _name, lo, hi: np.asarray(chans[i]["data"][lo:hi]), req)
+    if any(str(r.get("id5", "")).strip() == MARK for r in records):
+        raise InputError(
+            "the file's records are gearbody's, but its description record is missing (truncated?)"
+        )
     return _read_foreign(records, req)
 
 

@@ -156,15 +156,19 @@ def _read_foreign(data: np.ndarray, fs: float, req: ReadRequest) -> Recording:
     integer = data.dtype.kind in "iu"
     full_scale = float(2 ** (8 * data.dtype.itemsize - 1)) if integer else 1.0
     offset = full_scale if data.dtype.kind == "u" else 0.0  # 8-bit PCM is unsigned around 128
-    scale = (cal * factor / full_scale)[:, None]
+    scale = cal * factor / full_scale
     out = np.empty((len(wanted), hi - lo), dtype=np.float64)
     for a in range(lo, hi, BLOCK_SAMPLES):
         b = min(a + BLOCK_SAMPLES, hi)
-        block = data[a:b, cols].T  # a copy of one block, in the file's type
-        np.multiply(block - offset if offset else block, scale, out=out[:, a - lo : b - lo])
-        if not integer:
-            for j, name in enumerate(wanted):
-                check_finite(name, out[j, a - lo : b - lo], a)
+        for j, col in enumerate(cols):  # a view of the map, cast into the result: no copy of the block
+            seg = out[j, a - lo : b - lo]
+            if offset:
+                np.subtract(data[a:b, col], offset, out=seg)
+                seg *= scale[j]
+            else:
+                np.multiply(data[a:b, col], scale[j], out=seg)
+            if not integer:
+                check_finite(wanted[j], seg, a)
     sensitivity = full_scale / (cal * factor) if integer else 1.0 / (cal * factor)
     chans = [
         Channel(name, out[j], UNIT_SCALE[units[j]][0], float(sensitivity[j])) for j, name in enumerate(wanted)
