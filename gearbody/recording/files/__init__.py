@@ -118,7 +118,8 @@ def read_recording(
     ``start_s``/``end_s`` (the samples of ``start_s <= t < end_s``, read by parts where the format
     allows), ``tacho_channel`` (a channel that is the tacho: a pulse train of ``pulses_per_rev`` pulses per
     revolution of shaft ``tacho_shaft``, or an encoder when its unit is an angle, ``rad``/``deg``/``rev``:
-    pulses_per_rev 0). Options for a foreign file, refused where the format cannot use them:
+    pulses_per_rev 0; it replaces a tacho the file holds). Options for a foreign file, refused where the
+    format cannot use them:
     ``sample_rate_hz`` (when the file gives none), ``units`` (``{channel: unit}``, a unit of
     :data:`~gearbody.recording.UNIT_SCALE`), ``calibration`` (WAV; see :mod:`.wav_format`).
     Errors are :class:`~gearbody.errors.InputError` naming the file, the option and what is allowed."""
