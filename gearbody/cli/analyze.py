@@ -41,6 +41,19 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
         "(pinion, wheel, wheel_2, motor, ...)",
     )
     parser.add_argument(
+        "--unit",
+        action="append",
+        default=[],
+        metavar="NAME=UNIT",
+        help="unit of a channel of a file that does not say it (g, m/s^2, mm/s, um, V, ...); repeatable",
+    )
+    parser.add_argument(
+        "--calibration",
+        metavar="FACTOR[,FACTOR...]",
+        help="WAV: the physical value of a full-scale sample (integer WAV) or of a file unit (float WAV), "
+        "one for every channel or one per channel of the file (comma-separated; channels ch1, ch2, ...)",
+    )
+    parser.add_argument(
         "--sample-rate", type=number(gt=0), metavar="HZ", help="sample rate of a file that does not say it"
     )
     parser.add_argument(
@@ -102,6 +115,7 @@ def open_recording(args, path: str | None = None, need_scenario: bool = True):
         from gearbody.recording.files import read_recording
 
         options = {"sample_rate_hz": args.sample_rate, "start_s": args.start, "end_s": args.end}
+        options.update(_units_and_calibration(args))
         if args.tacho:
             options.update(
                 tacho_channel=args.tacho, pulses_per_rev=args.pulses_per_rev, tacho_shaft=args.tacho_shaft
@@ -124,10 +138,50 @@ def open_recording(args, path: str | None = None, need_scenario: bool = True):
     return rec, scenario
 
 
+def _units_and_calibration(args) -> dict:
+    """read_recording's ``units`` and ``calibration`` from --unit NAME=UNIT and --calibration."""
+    from gearbody.errors import InputError
+
+    out: dict = {}
+    units = {}
+    for text in args.unit:
+        name, eq, unit = text.partition("=")
+        if not eq or not name:
+            raise InputError(f"--unit {text}: expected NAME=UNIT, e.g. acc1=g")
+        units[name] = unit
+    if units:
+        out["units"] = units
+    if args.calibration:
+        try:
+            values = [float(v) for v in args.calibration.split(",")]
+        except ValueError:
+            raise InputError(
+                f"--calibration {args.calibration}: expected a number, or one per channel separated by commas"
+            ) from None
+        out["calibration"] = values[0] if len(values) == 1 else values
+    return out
+
+
 def _run_recording(source: Path, args):
     from gearbody.errors import InputError
     from gearbody.result import Result
 
+    given = [
+        o
+        for o, v in (
+            ("--unit", args.unit),
+            ("--calibration", args.calibration),
+            ("--sample-rate", args.sample_rate),
+            ("--tacho", args.tacho),
+        )
+        if v
+    ]
+    if given:
+        raise InputError(
+            f"{', '.join(given)}: a run's recording carries its units, sample rate and tacho (its exact "
+            "shaft angles); these options apply to files only (--tacho-shaft and --pulses-per-rev choose "
+            "the run's virtual tacho)"
+        )
     npz = source / "result.npz" if source.is_dir() else source
     if not npz.is_file():
         raise InputError(f"RECORDING {source}: a folder must hold a run's result.npz")

@@ -59,6 +59,8 @@ def execute(args) -> int:
             "end": None,
             "input_speed": None,
             "sample_rate": None,
+            "unit": [],
+            "calibration": None,
             "scene": None,
         }
     )

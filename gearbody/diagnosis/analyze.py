@@ -112,9 +112,15 @@ def analyze_recording(
     envelope: bool = True,
     kurtogram_level: int = 6,
 ) -> Diagnosis:
-    """The :class:`Diagnosis` of ``channels`` (default: the recording's vibration channels, at most 4)
+    """The :class:`Diagnosis` of ``channels`` (default: a simulated recording's vibration signal, else the
+    recording's vibration channels, at most 4)
     with the drive's kinematics ``drive`` (:meth:`DriveKinematics.from_scenario`)."""
-    names = list(channels) if channels else recording.vibration_channels[:4]
+    if channels:
+        names = list(channels)
+    elif recording.meta.get("vibration_channel") in recording:  # a run: the signal its own report reads
+        names = [recording.meta["vibration_channel"]]
+    else:
+        names = recording.vibration_channels[:4]
     if not names:
         raise InputError(f"the recording has no vibration channel; channels: {', '.join(recording.names)}")
     for name in names:
