@@ -117,7 +117,11 @@ def _prominent_peaks(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(peak bins, their prominence over the local floor [dB], the positions kept)``: the local maxima
     ``min_prominence_db`` over the median of +- ``floor_bins``, from bin 2 up to ``f_max_hz``; the
-    ``max_peaks`` most prominent kept, in order of frequency."""
+    ``max_peaks`` most prominent kept, in order of frequency. Above ``f_max_hz`` only the bins that the
+    floor and the local maxima up to it need are looked at (a long record's spectrum: most of its bins)."""
+    if f_max_hz is not None:
+        top = int(np.searchsorted(f, f_max_hz, side="right")) + floor_bins + 64  # the windows reach so far
+        f, a = f[:top], a[:top]
     floor = running_median(a, 2 * floor_bins + 1)
     index = local_maxima(a)
     index = index[a[index] >= (floor * 10.0 ** (min_prominence_db / 20.0))[index]]

@@ -213,7 +213,7 @@ def execute(args) -> int:
     drive = DriveKinematics.from_scenario(scenario)
     keys = (
         "scene",
-        "set",
+        "overrides",
         "channel",
         "tacho",
         "pulses_per_rev",
@@ -223,6 +223,8 @@ def execute(args) -> int:
         "start",
         "end",
         "no_envelope",
+        "unit",
+        "calibration",
     )
     identity = {"recording": str(Path(args.recording).resolve()), **{k: getattr(args, k, None) for k in keys}}
     with claim(out, "analyze", identity, overwrite=args.overwrite) as folder:

@@ -134,7 +134,7 @@ def add_overwrite(parser: argparse.ArgumentParser, same: str) -> None:
 def scenario_overrides(args) -> list[str]:
     """The --set overrides, plus operation.t_end_s from --t-end when given."""
     overrides = list(args.overrides)
-    if args.t_end is not None:
+    if getattr(args, "t_end", None) is not None:
         overrides.append(f"operation.t_end_s={args.t_end!r}")
     return overrides
 
@@ -144,7 +144,7 @@ def scenario_labels(args) -> list[str]:
     from gearbody.model.io import override_label
 
     labels = [override_label(o) for o in args.overrides]
-    if args.t_end is not None:
+    if getattr(args, "t_end", None) is not None:
         labels.append(f"--t-end {args.t_end!r}")
     return labels
 

@@ -74,7 +74,7 @@ def execute(args) -> int:
     rec_channel = (args.channel or rec.vibration_channels)[0]
     keys = (
         "scene",
-        "set",
+        "overrides",
         "channel",
         "run_channel",
         "tacho",

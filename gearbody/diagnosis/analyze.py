@@ -7,7 +7,7 @@ families. A :class:`Diagnosis` holds it all; ``features()`` flattens it into nam
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -30,6 +30,12 @@ def axis_spectrum(axis, amplitude, window: str) -> Spectrum:
     axis = np.asarray(axis, dtype=float)
     n = 2 * (axis.size - 1)
     return Spectrum(axis, np.asarray(amplitude, dtype=float), float(axis[1] - axis[0]) * n, str(window), n)
+
+
+def truncated(spec: Spectrum, top: float) -> Spectrum:
+    """``spec`` up to ``top`` (and 64 bins): what is labelled and drawn, not every bin of a long record."""
+    k = int(np.searchsorted(spec.frequency_hz, top, side="right")) + 64
+    return replace(spec, frequency_hz=spec.frequency_hz[:k].copy(), amplitude=spec.amplitude[:k].copy())
 
 
 @dataclass
@@ -143,41 +149,44 @@ def _channel(recording: Recording, name: str, angles: ShaftAngles, envelope: boo
     f_max = min(fs / 2, (HARMONICS + 0.5) * f_top * f_in)
     lines_hz = drive.lines(f_in, f_max)
     peaks = label_peaks(spec, lines_hz, min_prominence_db=12.0, max_peaks=40, f_max_hz=f_max)
-    out = ChannelDiagnosis(name, ch.unit, spec, peaks, _signal=x)
+    out = ChannelDiagnosis(name, ch.unit, truncated(spec, f_max), peaks, _signal=x)
     _orders(out, x, fs, angles, f_max / f_in)
-    _averages(out, x, angles)
     if envelope:
         _envelope(out, x, fs, angles, level)
     return out
 
 
 def _orders(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, max_order: float) -> None:
+    """The channel tracked once on the input shaft's angle (its whole band): the order spectrum up to
+    ``max_order`` with its labels and fault bands, and from the same tracked signal the synchronous
+    average of every gear's shaft (:mod:`.averages`)."""
     from ..analysis.order_maps import order_spectrum
     from ..analysis.orders import order_track
+    from .averages import shaft_average
 
     revs = (angles.input_angle_rad[-1] - angles.input_angle_rad[0]) / (2 * np.pi)
     if revs < MIN_TSA_REVOLUTIONS:
-        out.notes.append(f"no order spectrum: the input shaft turns {revs:.1f} revolutions (needs 3)")
+        out.notes.append(
+            f"no order spectrum and no averages: the input shaft turns {revs:.1f} revolutions "
+            f"(needs {MIN_TSA_REVOLUTIONS})"
+        )
         return
-    tracked = order_track(x, fs, angles.input_angle_rad, max_order=max_order)
+    tracked = order_track(x, fs, angles.input_angle_rad)
     ospec = order_spectrum(tracked)
     spec = axis_spectrum(ospec.order, ospec.amplitude, ospec.window)
-    lines = angles.drive.lines(1.0, float(spec.frequency_hz[-1]))
-    out.order_spectrum = spec
-    out.order_peaks = label_peaks(spec, lines, min_prominence_db=12.0, max_peaks=40, f_max_hz=max_order)
+    top = min(max_order, float(spec.frequency_hz[-1]))
+    lines = angles.drive.lines(1.0, top)
+    out.order_spectrum = truncated(spec, top)
+    out.order_peaks = label_peaks(spec, lines, min_prominence_db=12.0, max_peaks=40, f_max_hz=top)
     out.bands = band_metrics(spec, lines)
-
-
-def _averages(out: ChannelDiagnosis, x, angles: ShaftAngles) -> None:
-    from ..analysis import synchronous_average
-
-    for gear in angles.drive.gears:
-        angle = angles.of(gear.body)
-        revs = (angle[-1] - angle[0]) / (2 * np.pi)
-        if revs < MIN_TSA_REVOLUTIONS or gear.teeth is None:
-            out.notes.append(f"no synchronous average of {gear.body}: {revs:.1f} revolutions (needs 3)")
+    drive = angles.drive
+    for gear in drive.gears:
+        ratio = abs(drive.ratio(gear.body, drive.input_body))
+        n = revs * ratio
+        if n < MIN_TSA_REVOLUTIONS or gear.teeth is None:
+            out.notes.append(f"no synchronous average of {gear.body}: {n:.1f} revolutions (needs 3)")
             continue
-        tsa = synchronous_average(x, angle, teeth=gear.teeth)
+        tsa = shaft_average(tracked, ratio, gear.teeth)
         out.averages[gear.body] = tsa
         out.indicators[gear.body] = condition_indicators_from_average(tsa).as_dict()
         out.cepstral_peaks[gear.body] = _cepstral(x, angles, gear.body)
@@ -220,7 +229,7 @@ def _envelope(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, level: int) -> 
     out.kurtogram = kurt
     band = kurt.band_hz
     f_in = angles.mean_input_hz()
-    env = envelope_spectrum(x, fs, band_hz=band, convention="squared")
+    env = envelope_spectrum(x, fs, band_hz=band, convention="squared", max_frequency_hz=kurt.bandwidth_hz / 2)
     out.envelope = env
     spec = axis_spectrum(env.frequency_hz, env.amplitude, env.window)
     f_max = min(float(spec.frequency_hz[-1]), kurt.bandwidth_hz / 2)

@@ -92,11 +92,16 @@ def save_figure(fig: Figure, path: PathLike, dpi: int = 100) -> Path:
     return atomic_write(out, lambda tmp: fig.savefig(tmp, dpi=dpi, format="png"))
 
 
-def png_base64(fig: Figure, dpi: int = 100) -> str:
-    """``fig`` as PNG, base64-encoded (for ``<img src="data:image/png;base64,...">``)."""
+def png_bytes(fig: Figure, dpi: int = 100) -> bytes:
+    """``fig`` as PNG bytes (drawn once: write them to a file and embed them in a page alike)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     FigureCanvasAgg(fig)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
+    return buf.getvalue()
+
+
+def png_base64(fig: Figure, dpi: int = 100) -> str:
+    """``fig`` as PNG, base64-encoded (for ``<img src="data:image/png;base64,...">``)."""
+    return base64.b64encode(png_bytes(fig, dpi)).decode("ascii")

@@ -3,6 +3,7 @@ labelled with the drive's lines), and overlay_orders.png."""
 
 from __future__ import annotations
 
+import base64
 import html
 from dataclasses import replace
 from pathlib import Path
@@ -11,7 +12,7 @@ import numpy as np
 
 from gearbody.analysis import Spectrum  # noqa: F401 (the type of what _normalised takes)
 from gearbody.folders import atomic_write, write_text
-from gearbody.plotting.figure import png_base64, save_figure
+from gearbody.plotting.figure import png_bytes
 from gearbody.plotting.recording import overlay_figure
 
 from .html import _table
@@ -48,9 +49,10 @@ def write_comparison(comparison, out: str | Path, title: str) -> list[Path]:
             unit,
             max_order,
         )
-        image = png_base64(fig)
+        data = png_bytes(fig)  # drawn once, written and embedded
+        image = base64.b64encode(data).decode("ascii")
         path = out / "overlay_orders.png"
-        atomic_write(path, lambda p: save_figure(fig, p))
+        atomic_write(path, lambda p: Path(p).write_bytes(data))
         written.append(path)
     page = [
         "<!DOCTYPE html><html><head><meta charset='utf-8'>",

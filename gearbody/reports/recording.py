@@ -4,6 +4,7 @@ simulated one alike."""
 
 from __future__ import annotations
 
+import base64
 import html
 import json
 import re
@@ -12,7 +13,7 @@ from typing import Any
 
 from gearbody.analysis import peaks_to_rows
 from gearbody.folders import atomic_write, write_text
-from gearbody.plotting.figure import png_base64, save_figure
+from gearbody.plotting.figure import png_bytes
 from gearbody.plotting.recording import (
     envelope_figure,
     kurtogram_figure,
@@ -82,9 +83,10 @@ def write_diagnosis(diag, out: str | Path, title: str = "") -> list[Path]:
     written = []
     images = {}
     for stem, fig in figs.items():
-        images[stem] = png_base64(fig)
+        data = png_bytes(fig)  # drawn once, written and embedded
+        images[stem] = base64.b64encode(data).decode("ascii")
         path = out / f"{stem}.png"
-        atomic_write(path, lambda p, fig=fig: save_figure(fig, p))
+        atomic_write(path, lambda p, data=data: Path(p).write_bytes(data))
         written.append(path)
     features = diag.features()
     write_text(out / "features.json", json.dumps(features, indent=2, sort_keys=True) + "\n")
