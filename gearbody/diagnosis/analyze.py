@@ -22,6 +22,9 @@ from .speed import ShaftAngles, shaft_angles
 __all__ = ["ChannelDiagnosis", "Diagnosis", "analyze_recording"]
 
 MIN_TSA_REVOLUTIONS = 3
+TSA_ORDERS = 4
+"""The tracked band (orders of the input shaft) over the labelled one: the averages keep 4 x 6.5 mesh
+harmonics."""
 HARMONICS = 6
 
 
@@ -67,6 +70,12 @@ class ChannelDiagnosis:
         return axis_spectrum(self.envelope.frequency_hz, self.envelope.amplitude, self.envelope.window)
 
     def features(self) -> dict[str, float]:
+        """Named numbers (computed once): see :meth:`_features`."""
+        if self._features_cache is None:
+            self._features_cache = self._features()
+        return dict(self._features_cache)
+
+    def _features(self) -> dict[str, float]:
         """Named numbers: ``rms``, ``kurtosis``, ``crest_factor`` of the channel; ``<indicator>:<body>``;
         ``band_peak:<line>`` and ``band_power:<line>`` (order domain); ``envelope_peak:<line>``;
         ``cepstrum:<body>``."""
@@ -85,6 +94,7 @@ class ChannelDiagnosis:
         return {k: float(v) for k, v in out.items()}
 
     _signal: np.ndarray = field(default=None, repr=False)
+    _features_cache: dict | None = field(default=None, repr=False)
 
 
 @dataclass
@@ -171,7 +181,16 @@ def _orders(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, max_order: float)
             f"(needs {MIN_TSA_REVOLUTIONS})"
         )
         return
-    tracked = order_track(x, fs, angles.input_angle_rad)
+    # the band of the averages: TSA_ORDERS times the labelled orders (dozens of mesh harmonics), or what
+    # the lowest speed's Nyquist order allows (order_track's default)
+    f_lowest = float(np.min(np.diff(angles.input_angle_rad))) * fs / (2 * np.pi)
+    nyquist_order = 0.8 * (fs / 2) / max(f_lowest, 1e-9) / 1.25
+    try:
+        tracked = order_track(
+            x, fs, angles.input_angle_rad, max_order=min(TSA_ORDERS * max_order, nyquist_order)
+        )
+    except InputError:  # a wide speed range: the grid that band needs is over order_track's cap
+        tracked = order_track(x, fs, angles.input_angle_rad)
     ospec = order_spectrum(tracked)
     spec = axis_spectrum(ospec.order, ospec.amplitude, ospec.window)
     top = min(max_order, float(spec.frequency_hz[-1]))

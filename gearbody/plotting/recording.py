@@ -22,8 +22,9 @@ __all__ = [
     "shaft_tsa_figure",
 ]
 
-MAX_PLOT_POINTS = 200_000
-"""Points drawn of a spectrum at most: longer spectra are reduced to each pixel group's maximum."""
+MAX_PLOT_POINTS = 10_000
+"""Points drawn of a spectrum at most (~9 per pixel column of a 1100-pixel figure): longer spectra are
+reduced to each group's maximum, so every line stays in the picture."""
 
 
 def reduced(spectrum, x_max: float):

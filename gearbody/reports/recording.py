@@ -8,6 +8,7 @@ import base64
 import html
 import json
 import re
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +19,7 @@ from gearbody.plotting.recording import (
     envelope_figure,
     kurtogram_figure,
     order_spectrum_figure,
+    reduced,
     shaft_tsa_figure,
 )
 from gearbody.plotting.report import labelled_spectrum_figure
@@ -37,52 +39,63 @@ def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_")
 
 
-def diagnosis_figures(diag) -> dict[str, Any]:
-    """``{file stem: Figure}`` of every channel: spectrum, orders, TSA per shaft, kurtogram, envelope."""
-    figs: dict[str, Any] = {}
+def diagnosis_figures(diag) -> Iterator[tuple[str, Any]]:
+    """``(file stem, Figure)`` of every channel, one at a time (a long recording's figures are drawn and
+    let go in turn): spectrum, orders, TSA per shaft, kurtogram, envelope."""
     f_in = diag.mean_input_hz
     for name, ch in diag.channels.items():
         tag = _slug(name)
         f_max = max((p.frequency_hz for p in ch.peaks), default=ch.spectrum.frequency_hz[-1]) * 1.05
-        figs[f"spectrum_{tag}"] = labelled_spectrum_figure(
-            ch.spectrum,
-            ch.peaks,
-            f"spectrum of {name} [{ch.unit}], input shaft {f_in:.3f} rev/s",
-            ch.unit,
-            min(float(ch.spectrum.frequency_hz[-1]), f_max),
+        yield (
+            f"spectrum_{tag}",
+            labelled_spectrum_figure(
+                reduced(ch.spectrum, float(ch.spectrum.frequency_hz[-1])),
+                ch.peaks,
+                f"spectrum of {name} [{ch.unit}], input shaft {f_in:.3f} rev/s",
+                ch.unit,
+                min(float(ch.spectrum.frequency_hz[-1]), f_max),
+            ),
         )
         if ch.order_spectrum is not None:
             max_order = float(ch.order_spectrum.frequency_hz[-1])
-            figs[f"orders_{tag}"] = order_spectrum_figure(
-                ch.order_spectrum, ch.order_peaks, f"order spectrum of {name} [{ch.unit}]", ch.unit, max_order
+            yield (
+                f"orders_{tag}",
+                order_spectrum_figure(
+                    ch.order_spectrum,
+                    ch.order_peaks,
+                    f"order spectrum of {name} [{ch.unit}]",
+                    ch.unit,
+                    max_order,
+                ),
             )
         for body, tsa in ch.averages.items():
-            figs[f"tsa_{tag}_{_slug(body)}"] = shaft_tsa_figure(tsa, name, body, ch.unit)
+            yield f"tsa_{tag}_{_slug(body)}", shaft_tsa_figure(tsa, name, body, ch.unit)
         if ch.kurtogram is not None:
             k = ch.kurtogram
             title = f"kurtogram of {name}: band {k.centre_hz:.0f} Hz +- {k.bandwidth_hz / 2:.0f} Hz"
-            figs[f"kurtogram_{tag}"] = kurtogram_figure(k, title)
+            yield f"kurtogram_{tag}", kurtogram_figure(k, title)
         if ch.envelope is not None:
             f_top = max(10 * f_in, max((b.centre for b in ch.envelope_bands), default=0.0) * 2.2)
             f_top = min(f_top, float(ch.envelope.frequency_hz[-1]))
-            figs[f"envelope_{tag}"] = envelope_figure(
-                ch.envelope_spectrum(),
-                ch.envelope_peaks,
-                f"squared-envelope spectrum of {name} in the kurtogram's band",
-                f"({ch.unit})^2",
-                f_top,
+            yield (
+                f"envelope_{tag}",
+                envelope_figure(
+                    ch.envelope_spectrum(),
+                    ch.envelope_peaks,
+                    f"squared-envelope spectrum of {name} in the kurtogram's band",
+                    f"({ch.unit})^2",
+                    f_top,
+                ),
             )
-    return figs
 
 
 def write_diagnosis(diag, out: str | Path, title: str = "") -> list[Path]:
     """Write report.html, features.json and the PNG figures of ``diag`` into folder ``out``."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    figs = diagnosis_figures(diag)
     written = []
     images = {}
-    for stem, fig in figs.items():
+    for stem, fig in diagnosis_figures(diag):
         data = png_bytes(fig)  # drawn once, written and embedded
         images[stem] = base64.b64encode(data).decode("ascii")
         path = out / f"{stem}.png"
