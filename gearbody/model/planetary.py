@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ..physics.planetary import PlanetaryGeometry, PlanetaryGeometryError, PlanetarySpeeds, planetary_speeds
-from .components import MAX_TEETH, Bearing
+from .components import MAX_TEETH, RIGID, Bearing, RollingGeometry
 from .faults import ErrorMode
 from .params import Node, ScenarioError, param
 from .planetary_faults import PlanetaryDamagedTooth, PlanetBearingDefect, check_faults
@@ -39,12 +39,28 @@ class PlanetaryMember(Node):
         doc="a registered bearing law instead of bearing_stiffness_N_per_m (a planet's acts in the carrier "
         "frame on its centre's offset from its pin; docs/planetary.md)",
     )
+    bearing_geometry: RollingGeometry | None = param(
+        None,
+        doc="rolling-element geometry of the isotropic linear bearing, for the defect frequencies (data "
+        "only; with a bearing law: bearing.geometry)",
+    )
     torsion_stiffness_Nm_per_rad: float | None = param(
         None, gt=0, doc="torsional support to the housing (the fixed member only, required there)"
     )
     torsion_damping_Nms_per_rad: float = param(0.0, ge=0, doc="damping of the torsional support")
 
+    @property
+    def rolling_geometry(self) -> RollingGeometry | None:
+        """The bearing's rolling geometry, from whichever form gives the bearing (None: not stated)."""
+        return self.bearing_geometry if self.bearing is None else self.bearing.geometry
+
     def __post_init__(self) -> None:
+        if self.bearing is not None and self.bearing.kind == RIGID:
+            raise ScenarioError(
+                "bearing.kind = 'rigid': the members of a planetary stage move in x and y on their "
+                "bearings; give a bearing law (e.g. 'linear' or 'hertzian') or bearing_stiffness_N_per_m "
+                "(its geometry: bearing.geometry or bearing_geometry)"
+            )
         if (self.bearing_stiffness_N_per_m is None) == (self.bearing is None):
             raise ScenarioError(
                 "bearing_stiffness_N_per_m = "
@@ -56,6 +72,11 @@ class PlanetaryMember(Node):
             raise ScenarioError(
                 f"bearing_damping_Ns_per_m = {self.bearing_damping_Ns_per_m:g}: with a bearing law the "
                 "damping is the law's (its parameters)"
+            )
+        if self.bearing is not None and self.bearing_geometry is not None:
+            raise ScenarioError(
+                "bearing_geometry: with a bearing law (bearing = { kind, parameters }) its geometry is "
+                "bearing.geometry; move it there"
             )
 
 
