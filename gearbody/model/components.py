@@ -161,3 +161,31 @@ class Gear(Node):
 class Machine(Node):
     inertia_kg_m2: float = param(gt=0, doc="driven machine inertia I_m")
     rated_torque_Nm: float = param(gt=0, doc="load torque at rated load on the machine shaft")
+
+
+@dataclass(frozen=True)
+class RollingBearingSpec:
+    """A rolling bearing of the drive, as the analysis needs it for its defect frequencies
+    (:meth:`gearbody.model.Scenario.rolling_bearings`).
+
+    ``body`` is the rotation (a key of :func:`gearbody.assembly.operating_point.nominal_speeds_rad_s`:
+    ``pinion``, ``wheel_2``, ``stage_2_carrier``, ``planet_1``) whose speed turns the bearing;
+    ``reference`` the rotation that holds its other race (a planet bearing's pin on the carrier:
+    ``carrier``), None for the housing. The bearing turns at ``speed(body) - speed(reference)``.
+    ``body_race`` says which race the body turns: ``"inner"`` (a shaft in the housing) or ``"outer"``
+    (a planet on its pin; the reference turns the inner race). ``key`` is the scenario key of its
+    geometry (``design.stages.1.pinion.bearing.geometry``, ``design.stages.1.planet.bearing_geometry``);
+    ``geometry`` the geometry stated there, None when none is."""
+
+    name: str
+    key: str
+    body: str
+    reference: str | None
+    body_race: str
+    geometry: RollingGeometry | None
+
+    @property
+    def relative(self) -> bool:
+        """True when the bearing turns at its body's speed relative to another rotation (not the
+        housing)."""
+        return self.reference is not None

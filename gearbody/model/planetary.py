@@ -12,9 +12,10 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ..physics.planetary import PlanetaryGeometry, PlanetaryGeometryError, PlanetarySpeeds, planetary_speeds
-from .components import MAX_TEETH, RIGID, Bearing, RollingGeometry
+from ..signals import stage_prefix
+from .components import MAX_TEETH, RIGID, Bearing, RollingBearingSpec, RollingGeometry
 from .faults import ErrorMode
-from .params import Node, ScenarioError, param
+from .params import Node, ScenarioError, param, stage_key
 from .planetary_faults import PlanetaryDamagedTooth, PlanetBearingDefect, check_faults
 
 MEMBERS = ("sun", "ring", "carrier")
@@ -338,6 +339,27 @@ class PlanetaryStage(Node):
     def input_teeth(self) -> int:
         """Teeth that set the mesh period along the input member's angle (the carrier: the ring's)."""
         return self.sun.teeth if self.input == "sun" else self.ring.teeth
+
+    def rolling_bearings(self, k: int) -> list[RollingBearingSpec]:
+        """The bearings of the stage at index ``k`` (from 0): sun, ring and carrier in the housing (their
+        inner races), then each planet's on its pin (the planet turns the outer race relative to the
+        carrier); named by the rotations of :func:`gearbody.signals.stage_prefix` (``stage_2_carrier``)."""
+        prefix, label = stage_prefix(k), "" if k == 0 else f"stage {k + 1} "
+        rows = [(name, name, name, None, "inner") for name in MEMBERS]
+        rows += [
+            ("planet", f"planet {n}", f"planet_{n}", "carrier", "outer") for n in range(1, self.planets + 1)
+        ]
+        out = []
+        for member, title, body, reference, race in rows:
+            m = getattr(self, member)  # its geometry: bearing.geometry with a law, else bearing_geometry
+            key = stage_key(k, f"{member}.bearing.geometry" if m.bearing else f"{member}.bearing_geometry")
+            ref = None if reference is None else prefix + reference
+            out.append(
+                RollingBearingSpec(
+                    f"{label}{title} bearing", key, prefix + body, ref, race, m.rolling_geometry
+                )
+            )
+        return out
 
 
 def _stage_geometry_message(text: str, angles_deg: Sequence[float] = ()) -> str:
