@@ -34,6 +34,8 @@ from .errors import (
 from .model import (
     Bearing,
     Operation,
+    RollingBearingSpec,
+    RollingGeometry,
     Scenario,
     dump_scenario,
     four_periods,
@@ -88,6 +90,8 @@ __all__ = [
     "ReferenceMismatch",
     "RenderError",
     "Result",
+    "RollingBearingSpec",
+    "RollingGeometry",
     "Scenario",
     "ScenarioError",
     "SignalError",

@@ -1,7 +1,7 @@
 """Declarative model: scenario dataclasses (DPTOCC factors), validation, TOML input/output, scenes."""
 
 from ..errors import ScenarioError
-from .components import Bearing, Gear, Machine, Motor, Shaft
+from .components import Bearing, Gear, Machine, Motor, RollingBearingSpec, RollingGeometry, Shaft
 from .faults import DamagedTooth, Eccentricity, ErrorMode, PittedTooth
 from .io import dump_scenario, load_scenario, parse_override, scenario_to_dict
 from .mesh import Mesh, MeshGeometry
@@ -26,6 +26,8 @@ __all__ = [
     "Operation",
     "PittedTooth",
     "Profile",
+    "RollingBearingSpec",
+    "RollingGeometry",
     "Scenario",
     "ScenarioError",
     "Shaft",

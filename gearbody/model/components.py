@@ -7,11 +7,14 @@ import inspect
 from dataclasses import dataclass
 
 from ..physics.bearings import BEARINGS, make_bearing
-from .params import Node, ScenarioError, param
+from .params import Node, ScenarioError, check_ranges, param
 
 MAX_TEETH = 2000
 """Largest tooth count of any gear (it sizes the per-tooth arrays of the mesh laws; large ring gears
 have a few hundred)."""
+
+RIGID = "rigid"
+"""The bearing kind of a torsional gear's bearing table (gearbody.physics.bearings.RigidBearing)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -33,13 +36,43 @@ class Shaft(Node):
 
 
 @dataclass(frozen=True, kw_only=True)
+class RollingGeometry(Node):
+    """The geometry of a rolling-element bearing that sets its defect frequencies (BPFO, BPFI, BSF, FTF):
+    data for the analysis only; no bearing law reads it, so it never changes a run."""
+
+    balls: int = param(ge=3, le=100, doc="number of rolling elements (balls or rollers) N")
+    ball_diameter_m: float = param(gt=0, doc="rolling-element diameter d (< pitch_diameter_m)")
+    pitch_diameter_m: float = param(gt=0, doc="pitch diameter D of the rolling-element centres (> d)")
+    contact_angle_deg: float = param(
+        0.0, ge=0, lt=90, doc="contact angle alpha (0: deep-groove ball or cylindrical roller bearing)"
+    )
+
+    def __post_init__(self) -> None:
+        check_ranges(self)  # built in Python as well as read from a file
+        if not self.ball_diameter_m < self.pitch_diameter_m:
+            raise ScenarioError(
+                f"ball_diameter_m = {self.ball_diameter_m:g}: must be < pitch_diameter_m = "
+                f"{self.pitch_diameter_m:g} (the ball must fit: its diameter d below the pitch diameter D "
+                "of the ball centres)"
+            )
+
+
+@dataclass(frozen=True, kw_only=True)
 class Bearing(Node):
     """Bearing between a gear centre and the housing: a registered law (gearbody.physics.bearings)
-    with its keyword parameters, and the effective housing mass seen at this bearing."""
+    with its keyword parameters, the effective housing mass seen at this bearing and, optionally, its
+    rolling geometry (data for the bearing defect frequencies; not read by the law). Kind ``"rigid"``
+    is the bearing of a torsional gear (lateral = "none"): it names the bearing and carries its
+    geometry, and the gear centre stays fixed."""
 
-    kind: str = param("linear", doc="registered bearing law, e.g. 'linear' or 'hertzian'")
-    housing_mass_kg: float = param(50.0, gt=0, doc="effective housing mass for the housing acceleration")
+    kind: str = param("linear", doc="registered bearing law, e.g. 'linear', 'hertzian' or 'rigid'")
+    housing_mass_kg: float = param(
+        50.0, gt=0, doc="effective housing mass for the housing acceleration (not used by 'rigid')"
+    )
     parameters: dict[str, float] = param(default_factory=dict, doc="keyword parameters of the law")
+    geometry: RollingGeometry | None = param(
+        None, doc="rolling-element geometry for the defect frequencies (data only: no effect on a run)"
+    )
 
     def __post_init__(self) -> None:
         law = self.law()  # refuse unknown kinds and bad parameters before anything runs
@@ -56,13 +89,18 @@ class Bearing(Node):
             )
         cls = BEARINGS[self.kind]
         signature = inspect.signature(cls).parameters
-        law = f"the {self.kind!r} law, which takes {', '.join(signature)}"
+        law = f"the {self.kind!r} law, which takes {', '.join(signature) or 'no parameters'}"
+        if self.kind == RIGID:
+            law += (
+                " (it is a torsional gear's, lateral = 'none'; a gear that moves takes a law with parameters)"
+            )
         for name, value in self.parameters.items():  # named as the user wrote them, not as Python's
             if name not in signature:
                 raise ScenarioError(f"parameters.{name} = {value!r}: not a parameter of {law}")
         for name, p in signature.items():
             if p.default is p.empty and name not in self.parameters:
-                raise ScenarioError(f"parameters.{name}: required by {law}")
+                hint = "" if self.parameters else f"; a torsional gear's bearing table is kind = {RIGID!r}"
+                raise ScenarioError(f"parameters.{name}: required by {law}{hint}")
         try:
             return make_bearing(self.kind, **self.parameters)
         except TypeError as exc:
@@ -86,7 +124,9 @@ class Gear(Node):
     inertia_kg_m2: float = param(gt=0, doc="polar moment of inertia")
     mass_kg: float = param(gt=0, doc="mass (lateral models)")
     lateral: str = param("none", choices=LATERAL, doc="free translations of the gear centre")
-    bearing: Bearing | None = param(None, doc="bearing to the housing (required when lateral)")
+    bearing: Bearing | None = param(
+        None, doc="bearing to the housing (required when lateral; kind 'rigid' when lateral = 'none')"
+    )
     face_width_m: float | None = param(
         None, gt=0, le=2, doc="face width b (pictures; from the mesh geometry; unset: 10 modules)"
     )
@@ -95,6 +135,20 @@ class Gear(Node):
         if self.lateral != "none" and self.bearing is None:
             raise ScenarioError(
                 f"lateral = {self.lateral!r} needs a bearing table (kind, housing_mass_kg, parameters)"
+            )
+        if self.bearing is None:
+            return
+        if self.lateral != "none" and self.bearing.kind == RIGID:
+            raise ScenarioError(
+                f"bearing.kind = 'rigid': a rigid bearing holds the gear centre fixed, but lateral = "
+                f"{self.lateral!r} lets it move on its bearing; give a bearing law (e.g. 'linear' or "
+                "'hertzian') with its parameters, or set lateral = 'none'"
+            )
+        if self.lateral == "none" and self.bearing.kind != RIGID:
+            raise ScenarioError(
+                f"bearing.kind = {self.bearing.kind!r}: the gear is torsional (lateral = 'none'), its "
+                "centre fixed, so its bearing table only names the bearing and carries its geometry: set "
+                "kind = 'rigid' (no parameters), or let the gear move on the law (lateral = 'y' or 'xy')"
             )
 
     @property
@@ -107,3 +161,31 @@ class Gear(Node):
 class Machine(Node):
     inertia_kg_m2: float = param(gt=0, doc="driven machine inertia I_m")
     rated_torque_Nm: float = param(gt=0, doc="load torque at rated load on the machine shaft")
+
+
+@dataclass(frozen=True)
+class RollingBearingSpec:
+    """A rolling bearing of the drive, as the analysis needs it for its defect frequencies
+    (:meth:`gearbody.model.Scenario.rolling_bearings`).
+
+    ``body`` is the rotation (a key of :func:`gearbody.assembly.operating_point.nominal_speeds_rad_s`:
+    ``pinion``, ``wheel_2``, ``stage_2_carrier``, ``planet_1``) whose speed turns the bearing;
+    ``reference`` the rotation that holds its other race (a planet bearing's pin on the carrier:
+    ``carrier``), None for the housing. The bearing turns at ``speed(body) - speed(reference)``.
+    ``body_race`` says which race the body turns: ``"inner"`` (a shaft in the housing) or ``"outer"``
+    (a planet on its pin; the reference turns the inner race). ``key`` is the scenario key of its
+    geometry (``design.stages.1.pinion.bearing.geometry``, ``design.stages.1.planet.bearing_geometry``);
+    ``geometry`` the geometry stated there, None when none is."""
+
+    name: str
+    key: str
+    body: str
+    reference: str | None
+    body_race: str
+    geometry: RollingGeometry | None
+
+    @property
+    def relative(self) -> bool:
+        """True when the bearing turns at its body's speed relative to another rotation (not the
+        housing)."""
+        return self.reference is not None

@@ -57,6 +57,8 @@ class StageKind:
       a result of another drive is refused.
     - ``mesh_report(scenario, k, load_fraction, path)``: ``gearbody mesh``'s report of the stage, (its
       text, the plot written at ``path`` or None when ``path`` is None).
+    - ``rolling_bearings(stage, k)``: the stage's bearings, a list of
+      :class:`gearbody.model.components.RollingBearingSpec` (for the bearing defect frequencies).
     """
 
     name: str
@@ -77,6 +79,7 @@ class StageKind:
     nominal_speeds: Callable | None = None
     render_parts: Callable | None = None
     mesh_report: Callable | None = None
+    rolling_bearings: Callable | None = None
 
 
 _KINDS: dict[str, StageKind] = {}

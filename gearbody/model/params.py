@@ -67,6 +67,17 @@ class Node:
         return dataclasses.replace(self, **checked)
 
 
+def check_ranges(node: Any) -> None:
+    """Check a node's number fields against their types and ranges, as :func:`from_dict` checks a value
+    read from a file: for a node built in Python (``RollingGeometry(balls=2, ...)``), whose
+    ``__post_init__`` calls this. A ScenarioError names the node, the field, its value and the range."""
+    hints = get_type_hints(type(node))
+    for f in dataclasses.fields(node):
+        value = getattr(node, f.name)
+        if hints[f.name] in (int, float) or isinstance(value, (int, float)):
+            _convert(value, hints[f.name], _Ctx(type(node).__name__, f.name), f.metadata)
+
+
 def describe_range(meta: typing.Mapping[str, Any]) -> str:
     """Human text for a field's allowed range, e.g. '> 0', '[0, 1]'."""
     if meta.get("choices"):

@@ -12,9 +12,10 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ..physics.planetary import PlanetaryGeometry, PlanetaryGeometryError, PlanetarySpeeds, planetary_speeds
-from .components import MAX_TEETH, Bearing
+from ..signals import stage_prefix
+from .components import MAX_TEETH, RIGID, Bearing, RollingBearingSpec, RollingGeometry
 from .faults import ErrorMode
-from .params import Node, ScenarioError, param
+from .params import Node, ScenarioError, param, stage_key
 from .planetary_faults import PlanetaryDamagedTooth, PlanetBearingDefect, check_faults
 
 MEMBERS = ("sun", "ring", "carrier")
@@ -39,12 +40,28 @@ class PlanetaryMember(Node):
         doc="a registered bearing law instead of bearing_stiffness_N_per_m (a planet's acts in the carrier "
         "frame on its centre's offset from its pin; docs/planetary.md)",
     )
+    bearing_geometry: RollingGeometry | None = param(
+        None,
+        doc="rolling-element geometry of the isotropic linear bearing, for the defect frequencies (data "
+        "only; with a bearing law: bearing.geometry)",
+    )
     torsion_stiffness_Nm_per_rad: float | None = param(
         None, gt=0, doc="torsional support to the housing (the fixed member only, required there)"
     )
     torsion_damping_Nms_per_rad: float = param(0.0, ge=0, doc="damping of the torsional support")
 
+    @property
+    def rolling_geometry(self) -> RollingGeometry | None:
+        """The bearing's rolling geometry, from whichever form gives the bearing (None: not stated)."""
+        return self.bearing_geometry if self.bearing is None else self.bearing.geometry
+
     def __post_init__(self) -> None:
+        if self.bearing is not None and self.bearing.kind == RIGID:
+            raise ScenarioError(
+                "bearing.kind = 'rigid': the members of a planetary stage move in x and y on their "
+                "bearings; give a bearing law (e.g. 'linear' or 'hertzian') or bearing_stiffness_N_per_m "
+                "(its geometry: bearing.geometry or bearing_geometry)"
+            )
         if (self.bearing_stiffness_N_per_m is None) == (self.bearing is None):
             raise ScenarioError(
                 "bearing_stiffness_N_per_m = "
@@ -56,6 +73,11 @@ class PlanetaryMember(Node):
             raise ScenarioError(
                 f"bearing_damping_Ns_per_m = {self.bearing_damping_Ns_per_m:g}: with a bearing law the "
                 "damping is the law's (its parameters)"
+            )
+        if self.bearing is not None and self.bearing_geometry is not None:
+            raise ScenarioError(
+                "bearing_geometry: with a bearing law (bearing = { kind, parameters }) its geometry is "
+                "bearing.geometry; move it there"
             )
 
 
@@ -317,6 +339,27 @@ class PlanetaryStage(Node):
     def input_teeth(self) -> int:
         """Teeth that set the mesh period along the input member's angle (the carrier: the ring's)."""
         return self.sun.teeth if self.input == "sun" else self.ring.teeth
+
+    def rolling_bearings(self, k: int) -> list[RollingBearingSpec]:
+        """The bearings of the stage at index ``k`` (from 0): sun, ring and carrier in the housing (their
+        inner races), then each planet's on its pin (the planet turns the outer race relative to the
+        carrier); named by the rotations of :func:`gearbody.signals.stage_prefix` (``stage_2_carrier``)."""
+        prefix, label = stage_prefix(k), "" if k == 0 else f"stage {k + 1} "
+        rows = [(name, name, name, None, "inner") for name in MEMBERS]
+        rows += [
+            ("planet", f"planet {n}", f"planet_{n}", "carrier", "outer") for n in range(1, self.planets + 1)
+        ]
+        out = []
+        for member, title, body, reference, race in rows:
+            m = getattr(self, member)  # its geometry: bearing.geometry with a law, else bearing_geometry
+            key = stage_key(k, f"{member}.bearing.geometry" if m.bearing else f"{member}.bearing_geometry")
+            ref = None if reference is None else prefix + reference
+            out.append(
+                RollingBearingSpec(
+                    f"{label}{title} bearing", key, prefix + body, ref, race, m.rolling_geometry
+                )
+            )
+        return out
 
 
 def _stage_geometry_message(text: str, angles_deg: Sequence[float] = ()) -> str:

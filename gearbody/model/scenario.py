@@ -19,9 +19,10 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
+from ..signals import gear_names
 from .budget import check_resources
 from .checks import check_planetary_in_drive, check_stage, check_topology, check_turning_senses
-from .components import Gear, Machine, Motor, Shaft
+from .components import Gear, Machine, Motor, RollingBearingSpec, Shaft
 from .faults import DamagedTooth, Eccentricity, ErrorMode, PittedTooth
 from .kinds import register_stage_kind, stage_kind
 from .mesh import Mesh
@@ -105,6 +106,26 @@ class Stage(Node):
     def output_arm_m(self) -> float:
         """The wheel's base radius: torque out per unit mesh force."""
         return self.wheel.base_radius_m
+
+    def rolling_bearings(self, k: int) -> list[RollingBearingSpec]:
+        """The bearings of the stage at index ``k`` (from 0) that have a bearing table: the pinion's and
+        the wheel's, each turning its inner race in the housing (named as in
+        :func:`gearbody.signals.gear_names`: ``pinion``, ``wheel_2``)."""
+        label = "" if k == 0 else f"stage {k + 1} "
+        return [
+            RollingBearingSpec(
+                f"{label}{role} bearing",
+                stage_key(k, f"{role}.bearing.geometry"),
+                body,
+                None,
+                "inner",
+                gear.bearing.geometry,
+            )
+            for role, body, gear in zip(
+                ("pinion", "wheel"), gear_names(k), (self.pinion, self.wheel), strict=True
+            )
+            if gear.bearing is not None
+        ]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -275,6 +296,18 @@ class Scenario(Node):
         """F_rated of the first stage."""
         return self.stage_rated_force_N(0)
 
+    def rolling_bearings(self) -> list[RollingBearingSpec]:
+        """Every bearing of the drive that the analysis may take defect frequencies of, in power-flow
+        order: each gear's with a bearing table (a lateral gear's, or a torsional gear's 'rigid' one),
+        each planetary member's. ``body`` (and ``reference``) name rotations of
+        :func:`gearbody.assembly.operating_point.nominal_speeds_rad_s`; ``geometry`` is None where the
+        scenario states none (see :class:`~gearbody.model.components.RollingBearingSpec`)."""
+        out: list[RollingBearingSpec] = []
+        for k, st in enumerate(self.stages):
+            hook = stage_kind(st).rolling_bearings
+            out += hook(st, k) if hook is not None else []
+        return out
+
 
 register_stage_kind(
     "parallel",
@@ -283,6 +316,7 @@ register_stage_kind(
     check=lambda k, scenario: check_stage(k, scenario.stages[k]),
     resolve_geometry=resolve_parallel_geometry,
     resolve_rating=resolve_parallel_rating,
+    rolling_bearings=Stage.rolling_bearings,
 )
 register_stage_kind(
     "planetary",
@@ -290,4 +324,5 @@ register_stage_kind(
     compound=True,
     check=check_planetary_in_drive,
     resolve_rating=lambda stage, k, rated_force_N: resolve_planetary_iso(stage, rated_force_N, k),
+    rolling_bearings=PlanetaryStage.rolling_bearings,
 )

@@ -191,7 +191,21 @@ def tangent_stiffness_damping(
     return k, c
 
 
-BEARINGS: dict[str, type] = {"linear": LinearBearing, "hertzian": HertzianBearing}
+@dataclass(frozen=True)
+class RigidBearing:
+    """A bearing that holds its gear centre fixed: no law, no dynamics. A torsional gear (lateral =
+    "none") may carry a bearing table of this kind to name its bearing and state its rolling geometry
+    (the defect frequencies of the analysis); the engine never builds it, and a gear that moves on its
+    bearing cannot take it (gearbody.model.components.Gear)."""
+
+    def force_N(self, displacement_m, velocity_m_s) -> np.ndarray:
+        raise ValueError(
+            "a 'rigid' bearing holds its gear centre fixed and has no force law: it belongs on a gear "
+            "with lateral = 'none', which the engine builds without one"
+        )
+
+
+BEARINGS: dict[str, type] = {"linear": LinearBearing, "hertzian": HertzianBearing, "rigid": RigidBearing}
 
 
 def register_bearing(kind: str, cls: type) -> None:
