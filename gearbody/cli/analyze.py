@@ -28,14 +28,12 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--pulses-per-rev",
-        type=int,
-        default=1,
+        type=number(whole=True, ge=0, le=100000),
         metavar="N",
         help="tacho pulses per revolution of its shaft (default 1)",
     )
     parser.add_argument(
         "--tacho-shaft",
-        default="input",
         metavar="SHAFT",
         help="the shaft the tacho measures: input (default), output, or a body of the scene "
         "(pinion, wheel, wheel_2, motor, ...)",
@@ -118,8 +116,21 @@ def open_recording(args, path: str | None = None, need_scenario: bool = True):
         options.update(_units_and_calibration(args))
         if args.tacho:
             options.update(
-                tacho_channel=args.tacho, pulses_per_rev=args.pulses_per_rev, tacho_shaft=args.tacho_shaft
+                tacho_channel=args.tacho,
+                pulses_per_rev=1 if args.pulses_per_rev is None else args.pulses_per_rev,
+                tacho_shaft=args.tacho_shaft or "input",
             )
+        else:
+            given = [
+                o
+                for o, v in (("--pulses-per-rev", args.pulses_per_rev), ("--tacho-shaft", args.tacho_shaft))
+                if v is not None
+            ]
+            if given:
+                raise InputError(
+                    f"{', '.join(given)}: describe the tacho of --tacho CHANNEL (a file's own "
+                    "tacho names its shaft and pulses)"
+                )
         rec = read_recording(source, **{k: v for k, v in options.items() if v is not None})
     if args.input_speed:
         rec.meta["input_speed_hz"] = float(args.input_speed)
@@ -186,10 +197,11 @@ def _run_recording(source: Path, args):
     if not npz.is_file():
         raise InputError(f"RECORDING {source}: a folder must hold a run's result.npz")
     result = Result.load_npz(npz)
-    shaft = args.tacho_shaft if args.tacho_shaft not in ("input", "output") else None
+    shaft = args.tacho_shaft if args.tacho_shaft not in (None, "input", "output") else None
     if shaft is None:
         shaft = "pinion" if "pinion_angle_rad" in result else "sun" if "sun_angle_rad" in result else "motor"
-    rec = result.to_recording(tacho_shaft=shaft, pulses_per_rev=args.pulses_per_rev)
+    ppr = 1 if args.pulses_per_rev is None else args.pulses_per_rev
+    rec = result.to_recording(tacho_shaft=shaft, pulses_per_rev=ppr)
     if args.start is not None or args.end is not None:
         rec = rec.window(args.start, args.end)
     elif result.meta.get("scenario"):  # a run: its steady end, as the run's own report reads it

@@ -35,6 +35,7 @@ class BearingLineSource:
     body: str
     reference: str
     geometry: Any  # gearbody.analysis.bearing_lines.BearingGeometry
+    outer_race_rotates: bool = False
 
 
 @dataclass(frozen=True)
@@ -166,17 +167,17 @@ class DriveKinematics:
             shaft_hz = abs(self.speed_ratios[b.body] - self.speed_ratios.get(b.reference, 0.0)) * input_hz
             if shaft_hz <= 0:
                 continue
-            freqs = bearing_frequencies(b.geometry, shaft_hz)
-            for symbol, f in (
-                ("BPFO", freqs.bpfo_hz),
-                ("BPFI", freqs.bpfi_hz),
-                ("2 BSF", 2 * freqs.bsf_hz),
-                ("FTF", freqs.ftf_hz),
+            freqs = bearing_frequencies(b.geometry, shaft_hz, outer_race_rotates=b.outer_race_rotates)
+            for symbol, f, first in (
+                ("BPFO", freqs.bpfo_hz, 1),
+                ("BPFI", freqs.bpfi_hz, 1),
+                ("BSF", freqs.bsf_hz, 2),  # a rolling element's defect strikes both races: 2 BSF
+                ("FTF", freqs.ftf_hz, 1),
             ):
-                for m in (1, 2):
-                    if 0 < m * f <= f_max_hz:
-                        label = f"{'' if m == 1 else f'{m} x '}{symbol} {b.name}"
-                        out.append(KinematicLine(m * f, label, "bearing", ((f"{symbol} {b.name}", m),)))
+                for k in (first, 2 * first):
+                    if 0 < k * f <= f_max_hz:
+                        label = f"{'' if k == 1 else f'{k} '}{symbol} {b.name}"
+                        out.append(KinematicLine(k * f, label, "bearing", ((f"{symbol} {b.name}", k),)))
         return out
 
 
@@ -212,4 +213,5 @@ def _bearings(scenario, ratios):
             continue
         g = spec.geometry
         geometry = BearingGeometry(g.balls, g.ball_diameter_m, g.pitch_diameter_m, g.contact_angle_deg)
-        yield BearingLineSource(spec.name, spec.body, getattr(spec, "reference", "") or "", geometry)
+        outer = getattr(spec, "body_race", "inner") == "outer"
+        yield BearingLineSource(spec.name, spec.body, getattr(spec, "reference", "") or "", geometry, outer)

@@ -73,7 +73,7 @@ def shaft_angles(recording: Recording, drive: DriveKinematics) -> ShaftAngles:
 
 
 def _tacholess(recording: Recording, drive: DriveKinematics) -> ShaftAngles:
-    from ..analysis.tacho import tacholess_angle
+    from ..analysis.tacholess import tacholess_angle
 
     gear = drive.gears[0]
     speed = recording.meta.get("input_speed_hz")
