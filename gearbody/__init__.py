@@ -45,18 +45,25 @@ from .model import (
     steady,
 )
 from .physics.bearings import register_bearing
+from .recording import Channel, Recording, Tacho
 from .result import Result
 from .version import __version__
 
 if TYPE_CHECKING:  # what __getattr__ gives, for type checkers and editors
     from . import analysis, extend, render, studies
+    from .diagnosis import DriveKinematics, analyze_recording
     from .engine import scene_modes as modes
     from .engine import simulate
+    from .recording.files import read_recording, write_recording
 
 _LAZY = {
     "simulate": ("gearbody.engine", "simulate"),
     "modes": ("gearbody.engine", "scene_modes"),
     "analysis": ("gearbody.analysis", None),
+    "read_recording": ("gearbody.recording.files", "read_recording"),
+    "write_recording": ("gearbody.recording.files", "write_recording"),
+    "analyze_recording": ("gearbody.diagnosis", "analyze_recording"),
+    "DriveKinematics": ("gearbody.diagnosis", "DriveKinematics"),
     "studies": ("gearbody.studies", None),
     "render": ("gearbody.render", None),
     "extend": ("gearbody.extend", None),
@@ -81,6 +88,13 @@ def __dir__() -> list[str]:
 
 __all__ = [
     "Bearing",
+    "Channel",
+    "DriveKinematics",
+    "Recording",
+    "Tacho",
+    "analyze_recording",
+    "read_recording",
+    "write_recording",
     "CalibrationFailed",
     "FolderInUse",
     "GearbodyError",

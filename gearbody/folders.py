@@ -82,8 +82,9 @@ RUN_PLOTS = (
     "ring_sensor_spectrum*.png",
 )
 
-ANALYSIS_PLOTS = ("spectrum_*.png", "orders_*.png", "tsa_*.png", "kurtogram_*.png", "envelope_*.png")
-"""The figures of 'gearbody analyze' (one set per channel)."""
+ANALYSIS_OUTPUTS = ("report.html", "features.json", "spectrum_*.png", "orders_*.png", "tsa_*.png",
+                    "kurtogram_*.png", "envelope_*.png")  # fmt: skip
+COMPARE_OUTPUTS = ("comparison.html", "comparison.json", "comparison.csv", "overlay_*.png")
 
 KINDS: dict[str, Kind] = {  # studies first: their spec files mark them
     "sweep": Kind(
@@ -111,18 +112,8 @@ KINDS: dict[str, Kind] = {  # studies first: their spec files mark them
         ("frame_*.png", "animation.gif", "animation.mp4"),
     ),
     "mesh": Kind("mesh", "'gearbody mesh' plots", ("mesh_stage*.png",), ("mesh_stage*.png",)),
-    "analyze": Kind(
-        "analyze",
-        "a 'gearbody analyze' report",
-        ("report.html", "features.json", *ANALYSIS_PLOTS),
-        ("features.json",),
-    ),
-    "compare": Kind(
-        "compare",
-        "a 'gearbody compare' comparison",
-        ("comparison.html", "comparison.json", "comparison.csv", "overlay_*.png"),
-        ("comparison.json",),
-    ),
+    "analyze": Kind("analyze", "a 'gearbody analyze' report", ANALYSIS_OUTPUTS, ("features.json",)),
+    "compare": Kind("compare", "a 'gearbody compare' comparison", COMPARE_OUTPUTS, ("comparison.json",)),
     "run": Kind(
         "run",
         "a 'gearbody run' result",

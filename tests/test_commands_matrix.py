@@ -23,6 +23,7 @@ STUDY_T_END = "0.003"
 KEY = "condition.friction_coefficient"  # a key every drive has
 COVERED = {
     "list", "new", "run", "modes", "mesh", "render", "validate", "sweep", "sensitivity", "calibrate", "info",
+    "analyze", "compare",
 }  # fmt: skip
 
 
@@ -73,6 +74,20 @@ def test_run_writes_result_summary_report_and_every_stages_plots(scene, tmp_path
     expected = expected_run_plots(scene)
     assert expected <= written, expected - written
     assert written - expected <= {"bearing_forces.png"}, written - expected
+    assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("scene", SCENES)
+def test_analyze_and_compare_take_every_scenes_run(scene, tmp_path, capsys):
+    """A run as a recording: analyze writes its report (a short run: what it cannot analyse is a note),
+    and compare sets the run beside itself (every ratio 1)."""
+    run = tmp_path / "run"
+    assert main(["run", scene, "--t-end", T_END, "--out", str(run), "--quiet", "--no-plots"]) == 0
+    assert main(["analyze", str(run), "--out", str(tmp_path / "a")]) == 0
+    assert (tmp_path / "a" / "report.html").is_file() and (tmp_path / "a" / "features.json").is_file()
+    assert main(["compare", str(run), str(run), "--out", str(tmp_path / "c")]) == 0
+    rows = json.loads((tmp_path / "c" / "comparison.json").read_text())["features"]
+    assert rows and all(r["ratio"] == 1.0 for r in rows if r["run"] != 0)
     assert capsys.readouterr().err == ""
 
 

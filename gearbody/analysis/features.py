@@ -363,6 +363,8 @@ register_feature(
 )
 del _statistic, _indicator
 
+from . import feature_providers  # noqa: E402, F401 (registers the features a higher layer computes)
+
 
 def feature_signals(spec: FeatureSpec | str, record: Record) -> tuple[str, ...]:
     """Names of the signals the feature reads from ``record`` (whether the record holds them or not);

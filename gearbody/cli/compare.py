@@ -4,15 +4,16 @@ analysis of both, their features with ratios, and their order spectra overlaid w
 from __future__ import annotations
 
 import argparse
-import csv
-import io
-import json
 from pathlib import Path
 
 from .analyze import add_recording_options, open_recording
 from .common import EXIT_OK, add_out, add_overwrite, add_set, check_out
 
 __all__ = ["register"]
+
+IDENTITY = ("scene", "overrides", "channel", "run_channel", "tacho", "pulses_per_rev", "tacho_shaft",
+            "sample_rate", "input_speed", "start", "end", "unit", "calibration")  # fmt: skip
+"""The options that make a comparison folder hold "the same comparison"."""
 
 
 def register(sub) -> argparse.ArgumentParser:
@@ -72,42 +73,27 @@ def execute(args) -> int:
     drive = DriveKinematics.from_scenario(scenario)
     run_channel = args.run_channel or run_rec.vibration_channels[0]
     rec_channel = (args.channel or rec.vibration_channels)[0]
-    keys = (
-        "scene",
-        "overrides",
-        "channel",
-        "run_channel",
-        "tacho",
-        "pulses_per_rev",
-        "tacho_shaft",
-        "sample_rate",
-        "input_speed",
-        "start",
-        "end",
-    )
     identity = {
         "run": str(Path(args.run).resolve()),
         "recording": str(Path(args.recording).resolve()),
-        **{k: getattr(args, k, None) for k in keys},
+        **{k: getattr(args, k, None) for k in IDENTITY},
     }
     with claim(out, "compare", identity, overwrite=args.overwrite) as folder:
         run_diag = analyze_recording(run_rec, drive, [run_channel], envelope=True)
         rec_diag = analyze_recording(rec, drive, [rec_channel], envelope=True)
         comparison = compare_diagnoses(run_diag, rec_diag, run_channel, rec_channel)
         folder.begin()
-        from gearbody.folders import write_text
-
-        write_text(out / "comparison.json", json.dumps(comparison.as_dict(), indent=2) + "\n")
-        buffer = io.StringIO()
-        writer = csv.DictWriter(buffer, fieldnames=["feature", "run", "recording", "ratio"])
-        writer.writeheader()
-        writer.writerows(comparison.rows)
-        write_text(out / "comparison.csv", buffer.getvalue())
-        write_comparison(comparison, out, f"{Path(args.run).name} beside {Path(args.recording).name}")
+        pages = write_comparison(comparison, out, f"{Path(args.run).name} beside {Path(args.recording).name}")
         folder.finish()
+    _show(comparison, drive.scene, out, pages)
+    return EXIT_OK
+
+
+def _show(comparison, scene: str, out: Path, pages: list[Path]) -> None:
+    run_channel, rec_channel = comparison.run_channel, comparison.recording_channel
     print(
         f"run {run_channel} [{comparison.run_side.unit}] beside recording {rec_channel} "
-        f"[{comparison.recording_side.unit}], drive {drive.scene}: {len(comparison.rows)} features"
+        f"[{comparison.recording_side.unit}], drive {scene}: {len(comparison.rows)} features"
     )
     shown = [
         r
@@ -119,5 +105,4 @@ def execute(args) -> int:
             f"  {row['feature']:32s} run {row['run']:<11.4g} recording {row['recording']:<11.4g} "
             f"ratio {row['ratio']:.3g}"
         )
-    print(f"wrote {out}/comparison.html, comparison.json, comparison.csv, overlay_orders.png")
-    return EXIT_OK
+    print(f"wrote {out}/{', '.join(p.name for p in pages)}")

@@ -22,6 +22,7 @@ from .common import (
 
 def register(sub) -> argparse.ArgumentParser:
     """Add the command's parser to ``sub`` (the subparsers of ``gearbody``)."""
+    # size: a flat list of add_argument calls, one per option, read top to bottom like --help
     se = sub.add_parser(
         "sensitivity",
         help="Morris screening or Sobol indices of features to scenario keys over ranges, resumable",

@@ -22,6 +22,8 @@ from .speed import ShaftAngles, shaft_angles
 __all__ = ["ChannelDiagnosis", "Diagnosis", "analyze_recording"]
 
 MIN_TSA_REVOLUTIONS = 3
+MIN_ENVELOPE_SAMPLES = 4096
+"""Fewest samples for the kurtogram's levels and an envelope spectrum worth reading."""
 TSA_ORDERS = 4
 """The tracked band (orders of the input shaft) over the labelled one: the averages keep 4 x 6.5 mesh
 harmonics."""
@@ -161,7 +163,11 @@ def _channel(recording: Recording, name: str, angles: ShaftAngles, envelope: boo
     peaks = label_peaks(spec, lines_hz, min_prominence_db=12.0, max_peaks=40, f_max_hz=f_max)
     out = ChannelDiagnosis(name, ch.unit, truncated(spec, f_max), peaks, _signal=x)
     _orders(out, x, fs, angles, f_max / f_in)
-    if envelope:
+    if envelope and x.size < MIN_ENVELOPE_SAMPLES:
+        out.notes.append(
+            f"no kurtogram and no envelope spectrum: {x.size} samples (they need {MIN_ENVELOPE_SAMPLES})"
+        )
+    elif envelope:
         _envelope(out, x, fs, angles, level)
     return out
 

@@ -5,8 +5,8 @@ a run the same way, so calibration and sensitivity take a recording's features a
 ``recording:feature=fm4:pinion,signal=pinion_housing_accel_y_m_s2`` analyses ``signal`` (default: the run's
 vibration signal) over the feature's window (default the final quarter) with the run's scenario, its exact
 input-shaft angle as the tacho; with ``target=V,sigma=S`` its value is the misfit (value - V) / S (a
-recording's feature as the target of a sensitivity analysis). Registering happens on import (the
-studies import this module)."""
+recording's feature as the target of a sensitivity analysis). :mod:`gearbody.analysis.features`
+registers the name and computes it with :data:`KIND` (imported on first use)."""
 
 from __future__ import annotations
 
@@ -14,9 +14,9 @@ import json
 from functools import lru_cache
 from pathlib import Path
 
-from ..analysis.features import WINDOW_OPTIONS, FeatureError, FeatureKind, register_feature
+from ..analysis.features import WINDOW_OPTIONS, FeatureError, FeatureKind
 
-__all__ = ["recording_feature_value", "target_from_features"]
+__all__ = ["KIND", "recording_feature_value", "target_from_features"]
 
 NAME = "recording"
 
@@ -89,11 +89,9 @@ def target_from_features(path: str | Path, key: str) -> tuple[str, float]:
     return key, float(values[matches[0]])
 
 
-register_feature(
-    NAME,
-    FeatureKind(
-        options=("feature", "signal", "target", "sigma", *WINDOW_OPTIONS),
-        signals=_signals,
-        value=recording_feature_value,
-    ),
+KIND = FeatureKind(
+    options=("feature", "signal", "target", "sigma", *WINDOW_OPTIONS),
+    signals=_signals,
+    value=recording_feature_value,
 )
+"""What ``gearbody.analysis.features`` computes the 'recording' feature it registers with."""

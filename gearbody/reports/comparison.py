@@ -4,7 +4,10 @@ labelled with the drive's lines), and overlay_orders.png."""
 from __future__ import annotations
 
 import base64
+import csv
 import html
+import io
+import json
 from dataclasses import replace
 from pathlib import Path
 
@@ -27,8 +30,15 @@ def _normalised(spec: Spectrum) -> Spectrum:
 
 
 def write_comparison(comparison, out: str | Path, title: str) -> list[Path]:
-    """Write comparison.html and overlay_orders.png of ``comparison`` into ``out``."""
+    """Write comparison.json, comparison.csv (feature, run, recording, ratio), comparison.html and
+    overlay_orders.png of ``comparison`` into ``out``."""
     out = Path(out)
+    write_text(out / "comparison.json", json.dumps(comparison.as_dict(), indent=2) + "\n")
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=["feature", "run", "recording", "ratio"])
+    writer.writeheader()
+    writer.writerows(comparison.rows)
+    write_text(out / "comparison.csv", buffer.getvalue())
     run, rec = comparison.run_side, comparison.recording_side
     written = []
     image = ""
@@ -70,4 +80,4 @@ def write_comparison(comparison, out: str | Path, title: str) -> list[Path]:
         "</body></html>",
     ]
     write_text(out / "comparison.html", "\n".join(page))
-    return [out / "comparison.html", *written]
+    return [out / "comparison.json", out / "comparison.csv", out / "comparison.html", *written]

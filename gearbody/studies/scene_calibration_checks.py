@@ -132,7 +132,6 @@ def check_targets(
 ) -> tuple[dict[str, tuple[str, ...]], list[str]]:
     """``(the cases used with their overrides, the parameters' keys)``: targets distinct with features
     that parse, every case read by a target, parameters distinct and none also set by an override."""
-    import gearbody.diagnosis.features  # noqa: F401 (registers the 'recording' feature)
     from gearbody.analysis.features import FeatureError, parse_feature
     from gearbody.model import parse_override
     from gearbody.model.io import override_label
@@ -170,7 +169,6 @@ def check_cases(
     """Every case a valid scenario, at every parameter bound and start too, holding its targets' windows
     and recording their signals; returns the estimated wall time of a simulation of each case that runs
     one (s; the costlier end of each parameter's range)."""
-    import gearbody.diagnosis.features  # noqa: F401 (registers the 'recording' feature)
     from gearbody.analysis.features import parse_feature
     from gearbody.model import ScenarioError, load_scenario
 

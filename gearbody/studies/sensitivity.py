@@ -316,7 +316,6 @@ def scene_features(
 ) -> dict[str, float]:
     """The ``features`` of the scene ``base`` (TOML data) with ``overrides`` and ``values`` set: a
     simulation, and the modes when a natural frequency is asked (only the modes when nothing else is)."""
-    import gearbody.diagnosis.features  # noqa: F401 (registers the 'recording' feature in a pool worker)
     from gearbody.analysis.features import evaluate_features, natural_frequency_hz, parse_feature
     from gearbody.engine import scene_modes, simulate
     from gearbody.model import load_scenario

@@ -47,7 +47,6 @@ def check_scene_inputs(
     """``(feature specs as text, parsed, scene label, TOML data, sha256)`` of a scene analysis, refused
     before anything runs: a feature that does not parse, a ``--set`` key also a ``--key``, a feature
     window the fixed scenario cannot hold, a range end that is no valid scenario."""
-    import gearbody.diagnosis.features  # noqa: F401 (registers the 'recording' feature)
     from gearbody.analysis.features import FeatureError, parse_feature
     from gearbody.model import ScenarioError, load_scenario, parse_override
 
