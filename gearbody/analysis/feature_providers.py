@@ -1,28 +1,21 @@
 """Features whose computation lives in a higher layer (the analysis of a recording needs the drive's
-scenario, which analysis does not import): registered here by name, so that every feature user knows
-them from the start, and computed by the named module's ``KIND``, imported on first use."""
+scenario, which analysis does not import): :mod:`.features` registers them by name, so that every
+feature user knows them from the start, and computes them by the named module's ``KIND``, imported on
+first use."""
 
 from __future__ import annotations
 
 import importlib
+from typing import Any
 
-from .features import WINDOW_OPTIONS, FeatureKind, register_feature
+__all__ = ["PROVIDED", "provided_kind"]
 
-__all__ = ["PROVIDED"]
-
-PROVIDED = {"recording": "gearbody.diagnosis.features"}
-"""Feature name -> the module whose ``KIND`` computes it."""
-
-
-def _provided(name: str) -> FeatureKind:
-    return importlib.import_module(PROVIDED[name]).KIND
+PROVIDED: dict[str, tuple[str, tuple[str, ...]]] = {
+    "recording": ("gearbody.diagnosis.features", ("feature", "signal", "target", "sigma")),
+}
+"""Feature name -> (the module whose ``KIND`` computes it, its options besides the window's)."""
 
 
-register_feature(
-    "recording",
-    FeatureKind(
-        ("feature", "signal", "target", "sigma", *WINDOW_OPTIONS),
-        lambda spec, record: _provided("recording").signals(spec, record),
-        lambda spec, record, names, mask: _provided("recording").value(spec, record, names, mask),
-    ),
-)
+def provided_kind(name: str) -> Any:
+    """The ``FeatureKind`` that computes provided feature ``name`` (its module imported now)."""
+    return importlib.import_module(PROVIDED[name][0]).KIND

@@ -58,6 +58,7 @@ from .feature_functions import (
     natural_frequency_hz,
     resonance_speed,
 )
+from .feature_providers import PROVIDED, provided_kind
 from .feature_record import (  # DEFAULT_FRACTION: this module's name before the split
     DEFAULT_FRACTION,  # noqa: F401
     FeatureError,
@@ -363,7 +364,15 @@ register_feature(
 )
 del _statistic, _indicator
 
-from . import feature_providers  # noqa: E402, F401 (registers the features a higher layer computes)
+for _name, (_, _options) in PROVIDED.items():  # computed by a higher layer, known from the start
+    register_feature(
+        _name,
+        FeatureKind(
+            (*_options, *WINDOW_OPTIONS),
+            lambda spec, record: provided_kind(spec.name).signals(spec, record),
+            lambda spec, record, names, mask: provided_kind(spec.name).value(spec, record, names, mask),
+        ),
+    )
 
 
 def feature_signals(spec: FeatureSpec | str, record: Record) -> tuple[str, ...]:
