@@ -1,11 +1,22 @@
 """Engine-free analysis of simulated or measured signals (plain numpy arrays in, dataclasses out): spectra
 and their labelled peaks, kinematic lines, synchronous averages and condition indicators, K_d statistics,
-features (registered by name, evaluated on a run or a measurement), and the modal results: a drive's
+features (registered by name, evaluated on a run or a measurement), the measured side (tacho pulses to
+shaft angle, tacholess speed, computed order tracking and order spectra, envelope spectra, kurtogram,
+cepstrum, bearing fault frequencies, acceleration/velocity/displacement), and the modal results: a drive's
 :class:`ModeSet` (from :func:`gearbody.modes`) and Lin & Parker's closed-form modes of a planetary stage.
 
 Public: the names of ``__all__``, importable from here (``from gearbody.analysis import ...``).
 """
 
+from gearbody.analysis.bearing_lines import BearingFrequencies, BearingGeometry, bearing_frequencies
+from gearbody.analysis.cepstrum import (
+    CepstralPeak,
+    Cepstrum,
+    cepstral_peak,
+    cepstrum_prewhiten,
+    lifter_family,
+    real_cepstrum,
+)
 from gearbody.analysis.dynamic_factor import (
     INSTABILITY_KD,
     FoldedSignal,
@@ -16,6 +27,7 @@ from gearbody.analysis.dynamic_factor import (
     separation_stats,
     unstable,
 )
+from gearbody.analysis.envelope import EnvelopeSpectrum, envelope_spectrum
 from gearbody.analysis.features import (
     WINDOW_OPTIONS,
     FeatureError,
@@ -44,6 +56,7 @@ from gearbody.analysis.indicators import (
     rms,
     sideband_energy_ratio,
 )
+from gearbody.analysis.integration import change_quantity
 from gearbody.analysis.kinematics import (
     GearMesh,
     KinematicLine,
@@ -52,7 +65,17 @@ from gearbody.analysis.kinematics import (
     gear_train_lines,
     kinematic_lines,
 )
+from gearbody.analysis.kurtogram import Kurtogram, SpectralKurtosis, fast_kurtogram, spectral_kurtosis
 from gearbody.analysis.modal import ModeSet, campbell_lines, resonance_speeds_rad_s
+from gearbody.analysis.order_maps import (
+    OrderSlice,
+    OrderSpectrum,
+    RpmOrderMap,
+    order_slice,
+    order_spectrum,
+    rpm_order_map,
+)
+from gearbody.analysis.orders import OrderTrackedSignal, order_track
 from gearbody.analysis.peak_report import peaks_table, peaks_to_rows
 from gearbody.analysis.peaks import LabelledPeak, label_peaks
 from gearbody.analysis.planet_pass import (
@@ -74,6 +97,8 @@ from gearbody.analysis.spectrum import (
     peak_near,
     sideband_lines,
 )
+from gearbody.analysis.tacho import pulse_times, shaft_angle_from_pulses, shaft_speed_from_pulses
+from gearbody.analysis.tacholess import TacholessSpeed, tacholess_angle
 from gearbody.analysis.tsa import AngleDomainSignal, SynchronousAverage, angle_resample, synchronous_average
 
 # Lin & Parker's modes of a planetary stage: engine-free like ModeSet (numpy's eigh on their matrices)
@@ -85,6 +110,35 @@ from gearbody.physics.planetary_modal import (
 )
 
 __all__ = [
+    "BearingFrequencies",
+    "BearingGeometry",
+    "bearing_frequencies",
+    "CepstralPeak",
+    "Cepstrum",
+    "cepstral_peak",
+    "cepstrum_prewhiten",
+    "lifter_family",
+    "real_cepstrum",
+    "EnvelopeSpectrum",
+    "envelope_spectrum",
+    "change_quantity",
+    "Kurtogram",
+    "SpectralKurtosis",
+    "fast_kurtogram",
+    "spectral_kurtosis",
+    "OrderSlice",
+    "OrderSpectrum",
+    "RpmOrderMap",
+    "order_slice",
+    "order_spectrum",
+    "rpm_order_map",
+    "OrderTrackedSignal",
+    "order_track",
+    "pulse_times",
+    "shaft_angle_from_pulses",
+    "shaft_speed_from_pulses",
+    "TacholessSpeed",
+    "tacholess_angle",
     "HannPassWindow",
     "PlanetaryLine",
     "PlanetarySources",
