@@ -83,7 +83,7 @@ RUN_PLOTS = (
 )
 
 ANALYSIS_OUTPUTS = ("report.html", "features.json", "spectrum_*.png", "orders_*.png", "tsa_*.png",
-                    "kurtogram_*.png", "envelope_*.png")  # fmt: skip
+                    "kurtogram_*.png", "envelope_*.png", "rpm_orders_*.png")  # fmt: skip
 COMPARE_OUTPUTS = ("comparison.html", "comparison.json", "comparison.csv", "overlay_*.png")
 
 KINDS: dict[str, Kind] = {  # studies first: their spec files mark them

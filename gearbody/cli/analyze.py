@@ -91,6 +91,12 @@ def register(sub) -> argparse.ArgumentParser:
     add_set(p, "override a value of --scene's scenario by its dotted key (repeatable)")
     add_recording_options(p)
     p.add_argument("--no-envelope", action="store_true", help="skip the kurtogram and the envelope spectrum")
+    p.add_argument(
+        "--prewhiten",
+        action="store_true",
+        help="kurtogram and envelope spectrum of the cepstrum-prewhitened channel (the gears' lines "
+        "removed, so a bearing's impacts stand out; amplitudes relative)",
+    )
     add_out(p, "output folder (default: runs/analyze-<recording file stem>)")
     add_overwrite(p, "analysis")
     p.set_defaults(handler=execute)
@@ -235,12 +241,15 @@ def execute(args) -> int:
         "start",
         "end",
         "no_envelope",
+        "prewhiten",
         "unit",
         "calibration",
     )
     identity = {"recording": str(Path(args.recording).resolve()), **{k: getattr(args, k, None) for k in keys}}
     with claim(out, "analyze", identity, overwrite=args.overwrite) as folder:
-        diag = analyze_recording(rec, drive, args.channel, envelope=not args.no_envelope)
+        diag = analyze_recording(
+            rec, drive, args.channel, envelope=not args.no_envelope, prewhiten=args.prewhiten
+        )
         folder.begin()
         paths = write_diagnosis(diag, out, title=f"{Path(args.recording).name} on {drive.scene}")
         folder.finish()

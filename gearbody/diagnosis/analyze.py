@@ -63,6 +63,10 @@ class ChannelDiagnosis:
     envelope_peaks: list = field(default_factory=list)
     envelope_bands: list[BandMetric] = field(default_factory=list)
     cepstral_peaks: dict[str, float] = field(default_factory=dict)
+    rpm_order_map: Any = None
+    """Amplitude over (speed, order) when the speed varies by more than 5 % (a run-up)."""
+    prewhitened: bool = False
+    """True when the kurtogram and the envelope spectrum are of the cepstrum-prewhitened channel."""
     notes: list[str] = field(default_factory=list)
 
     def envelope_spectrum(self) -> Spectrum | None:
@@ -129,10 +133,13 @@ def analyze_recording(
     *,
     envelope: bool = True,
     kurtogram_level: int = 6,
+    prewhiten: bool = False,
 ) -> Diagnosis:
     """The :class:`Diagnosis` of ``channels`` (default: a simulated recording's vibration signal, else the
     recording's vibration channels, at most 4)
-    with the drive's kinematics ``drive`` (:meth:`DriveKinematics.from_scenario`)."""
+    with the drive's kinematics ``drive`` (:meth:`DriveKinematics.from_scenario`); ``prewhiten``: the
+    kurtogram and the envelope spectrum of the cepstrum-prewhitened channel (deterministic lines
+    removed: the bearing's impacts stand out over the gears' tones; amplitudes then relative)."""
     if channels:
         names = list(channels)
     elif recording.meta.get("vibration_channel") in recording:  # a run: the signal its own report reads
@@ -148,11 +155,11 @@ def analyze_recording(
     if angles.note:
         diag.notes.append(angles.note)
     for name in names:
-        diag.channels[name] = _channel(recording, name, angles, envelope, kurtogram_level)
+        diag.channels[name] = _channel(recording, name, angles, envelope, kurtogram_level, prewhiten)
     return diag
 
 
-def _channel(recording: Recording, name: str, angles: ShaftAngles, envelope: bool, level: int):
+def _channel(recording: Recording, name: str, angles: ShaftAngles, envelope: bool, level: int, white: bool):
     ch = recording.channel(name)
     x, fs, drive = ch.data, recording.sample_rate_hz, angles.drive
     f_in = angles.mean_input_hz()
@@ -168,7 +175,11 @@ def _channel(recording: Recording, name: str, angles: ShaftAngles, envelope: boo
             f"no kurtogram and no envelope spectrum: {x.size} samples (they need {MIN_ENVELOPE_SAMPLES})"
         )
     elif envelope:
-        _envelope(out, x, fs, angles, level)
+        if white:
+            from ..analysis import cepstrum_prewhiten
+
+            out.prewhitened = True
+        _envelope(out, cepstrum_prewhiten(x) if white else x, fs, angles, level)
     return out
 
 
@@ -204,6 +215,7 @@ def _orders(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, max_order: float)
     out.order_spectrum = truncated(spec, top)
     out.order_peaks = label_peaks(spec, lines, min_prominence_db=12.0, max_peaks=40, f_max_hz=top)
     out.bands = band_metrics(spec, lines)
+    _rpm_map(out, x, fs, angles, top, revs)
     drive = angles.drive
     for gear in drive.gears:
         ratio = abs(drive.ratio(gear.body, drive.input_body))
@@ -215,6 +227,35 @@ def _orders(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, max_order: float)
         out.averages[gear.body] = tsa
         out.indicators[gear.body] = condition_indicators_from_average(tsa).as_dict()
         out.cepstral_peaks[gear.body] = _cepstral(x, angles, gear.body)
+
+
+SPEED_RANGE_FOR_MAP = 1.05
+"""Highest over lowest speed (per revolution) above which the report shows the rpm-order map."""
+
+
+def _rpm_map(out: ChannelDiagnosis, x, fs, angles: ShaftAngles, max_order: float, revs: float) -> None:
+    from ..analysis import rpm_order_map
+
+    per_rev = np.diff(
+        np.interp(
+            np.arange(
+                np.ceil(angles.input_angle_rad[0] / (2 * np.pi)), angles.input_angle_rad[-1] / (2 * np.pi)
+            )
+            * 2
+            * np.pi,
+            angles.input_angle_rad,
+            angles.time_s,
+        )
+    )
+    if per_rev.size < 8 or per_rev.max() / per_rev.min() < SPEED_RANGE_FOR_MAP:
+        return
+    block = int(np.clip(revs // 60, 2, 32))
+    try:
+        out.rpm_order_map = rpm_order_map(
+            x, fs, angles.input_angle_rad, revolutions_per_block=block, max_order=max_order
+        )
+    except InputError as exc:  # the speed range too wide for the band: said, not drawn
+        out.notes.append(f"no rpm-order map: {exc}")
 
 
 def _cepstral(x, angles: ShaftAngles, body: str) -> float:

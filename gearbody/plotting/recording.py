@@ -19,6 +19,7 @@ __all__ = [
     "kurtogram_figure",
     "order_spectrum_figure",
     "overlay_figure",
+    "rpm_order_figure",
     "shaft_tsa_figure",
 ]
 
@@ -109,6 +110,31 @@ def kurtogram_figure(kurtogram, title: str) -> Figure:
     ax.axvspan(lo, lo + kurtogram.bandwidth_hz, color="red", alpha=0.25, lw=0)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("level")
+    set_title(ax, title)
+    return fig
+
+
+def rpm_order_figure(rpm_map, title: str, unit: str) -> Figure:
+    """Amplitude [dB re its largest cell] over order (x) and speed in rpm (y): a run-up's map."""
+    fig = new_figure((1100, 500), 100)
+    ax = fig.add_subplot(1, 1, 1)
+    a = np.asarray(rpm_map.amplitude)
+    db = 20 * np.log10(np.maximum(a, np.max(a) * 1e-4) / np.max(a))
+    order, rpm = np.asarray(rpm_map.order), np.asarray(rpm_map.speed_rpm)
+    sorted_rows = np.argsort(rpm)
+    image = ax.pcolormesh(
+        order,
+        rpm[sorted_rows],
+        db[sorted_rows],
+        shading="nearest",
+        cmap="viridis",
+        vmin=-60,
+        vmax=0,
+        rasterized=True,
+    )
+    fig.colorbar(image, ax=ax, label=f"amplitude [dB re {np.max(a):.3g} {unit}]")
+    ax.set_xlabel("order of the input shaft [cycles/rev]")
+    ax.set_ylabel("input shaft speed [rpm]")
     set_title(ax, title)
     return fig
 

@@ -20,6 +20,7 @@ from gearbody.plotting.recording import (
     kurtogram_figure,
     order_spectrum_figure,
     reduced,
+    rpm_order_figure,
     shaft_tsa_figure,
 )
 from gearbody.plotting.report import labelled_spectrum_figure
@@ -68,6 +69,11 @@ def diagnosis_figures(diag) -> Iterator[tuple[str, Any]]:
                     max_order,
                 ),
             )
+        if ch.rpm_order_map is not None:
+            title = (
+                f"rpm-order map of {name} ({ch.rpm_order_map.revolutions_per_block:g} revolutions per block)"
+            )
+            yield f"rpm_orders_{tag}", rpm_order_figure(ch.rpm_order_map, title, ch.unit)
         for body, tsa in ch.averages.items():
             yield f"tsa_{tag}_{_slug(body)}", shaft_tsa_figure(tsa, name, body, ch.unit)
         if ch.kurtogram is not None:
@@ -77,13 +83,14 @@ def diagnosis_figures(diag) -> Iterator[tuple[str, Any]]:
         if ch.envelope is not None:
             f_top = max(10 * f_in, max((b.centre for b in ch.envelope_bands), default=0.0) * 2.2)
             f_top = min(f_top, float(ch.envelope.frequency_hz[-1]))
+            white = " (cepstrum-prewhitened)" if ch.prewhitened else ""
             yield (
                 f"envelope_{tag}",
                 envelope_figure(
                     ch.envelope_spectrum(),
                     ch.envelope_peaks,
-                    f"squared-envelope spectrum of {name} in the kurtogram's band",
-                    f"({ch.unit})^2",
+                    f"squared-envelope spectrum of {name}{white} in the kurtogram's band",
+                    "relative" if ch.prewhitened else f"({ch.unit})^2",
                     f_top,
                 ),
             )
@@ -136,6 +143,7 @@ def _page(diag, images: dict[str, str], title: str) -> str:
             _table(peaks_to_rows(ch.peaks), list(PEAK_COLUMNS), headers),
             "<h3>Order spectrum (orders of the input shaft)</h3>",
             img(f"orders_{tag}"),
+            img(f"rpm_orders_{tag}"),
             _table([b.as_row() for b in ch.bands]),
             "<h3>Synchronous averages and condition indicators</h3>",
             _table(ind_rows),
