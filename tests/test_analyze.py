@@ -73,8 +73,9 @@ def test_synthetic_recording_gives_its_mesh_order_fault_and_bearing_line():
 
 def test_tacholess_analysis_finds_the_speed_from_the_mesh_harmonic():
     rec, drive, _ = _synthetic(tacho=False)
-    with pytest.raises(gb.InputError, match="--input-speed"):
-        analyze_recording(rec, drive, envelope=False)
+    diag = analyze_recording(rec, drive, envelope=False)  # searched near the scene's nominal 17.29 rev/s
+    assert "nominal input speed 17.29" in diag.notes[0]
+    assert diag.mean_input_hz == pytest.approx(17.0, rel=2e-3)
     rec.meta["input_speed_hz"] = 16.5  # a guess within 3 %
     diag = analyze_recording(rec, drive, envelope=False)
     assert diag.angles.source == "tacholess"
@@ -176,3 +177,22 @@ def test_recording_feature_on_a_run_and_calibrate_target_from(run_folder, tmp_pa
     assert target_from_features(tmp_path, "fm0:pinion") == ("fm0:pinion", 1.5)
     with pytest.raises(gb.InputError, match="no feature 'fm9'"):
         target_from_features(tmp_path, "fm9")
+
+
+def test_a_noise_tacho_and_a_dead_channel_are_refused_or_said():
+    rec, drive, _ = _synthetic(seconds=2.0)
+    n = rec.n_samples
+    noise = np.random.default_rng(0).normal(size=n)
+    noisy = Recording(
+        FS, [rec.channel("acc"), Channel("tacho", noise, "V")], tacho=Tacho("pinion", 1, channel="tacho")
+    )
+    with pytest.raises(gb.InputError, match="not a shaft's pulses"):
+        analyze_recording(noisy, drive)
+    fast = Tacho("pinion", 1, pulse_times_s=np.arange(1, 2000) * 1e-3)  # 1000 rev/s: 58 x nominal
+    with pytest.raises(gb.InputError, match="nominal 17.29 rev/s"):
+        analyze_recording(Recording(FS, [rec.channel("acc")], tacho=fast), drive)
+    dead = rec.with_channels(Channel("dead", np.zeros(n), "m/s^2"))
+    diag = analyze_recording(dead, drive, ["acc", "dead"], envelope=False)
+    assert list(diag.channels) == ["acc"] and "channel 'dead' is constant" in diag.notes[-1]
+    with pytest.raises(gb.InputError, match="every channel asked for is constant"):
+        analyze_recording(dead, drive, ["dead"])

@@ -154,7 +154,20 @@ def analyze_recording(
     diag = Diagnosis(recording, drive, angles, {})
     if angles.note:
         diag.notes.append(angles.note)
+    constant = [n for n in names if np.ptp(recording[n]) == 0]
+    if len(constant) == len(names):
+        raise InputError(f"every channel asked for is constant (a dead sensor?): {', '.join(constant)}")
     for name in names:
+        data = recording[name]
+        if not np.all(np.isfinite(data)):
+            raise InputError(
+                f"channel {name!r} holds {np.count_nonzero(~np.isfinite(data))} NaN or infinite samples"
+            )
+        if np.ptp(data) == 0:  # a dead sensor or an unconnected input: said, not analysed
+            diag.notes.append(
+                f"channel {name!r} is constant ({data[0]:g} {recording.channel(name).unit}): not analysed"
+            )
+            continue
         diag.channels[name] = _channel(recording, name, angles, envelope, kurtogram_level, prewhiten)
     return diag
 

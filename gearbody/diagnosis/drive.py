@@ -8,7 +8,8 @@ Ratios come from the scenario's nominal kinematics (every rotation's speed when 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass
 from typing import Any
 
 from ..analysis import KinematicLine, gear_train_lines
@@ -49,7 +50,8 @@ class DriveKinematics:
     gears: tuple[GearShaft, ...]
     bearings: tuple[BearingLineSource, ...] = ()
     input_body: str = "pinion"
-    notes: tuple[str, ...] = field(default=())
+    nominal_input_hz: float | None = None
+    """The input shaft's speed with the motor at its synchronous speed [rev/s] (None: Muller's model)."""
 
     @classmethod
     def from_scenario(cls, scenario) -> DriveKinematics:
@@ -61,15 +63,18 @@ class DriveKinematics:
         for st in stages:
             st.setdefault("type", "parallel")
         speeds = nominal_speeds_rad_s(scenario)
+        nominal = None
         if not speeds:  # Muller's model: no rotation coordinates; its gears' ratio from the teeth
             z1, z2 = stages[0]["pinion_teeth"], stages[0]["wheel_teeth"]
             speeds = {"pinion": 1.0, "wheel": z1 / z2}
         input_body = _input_body(stages, speeds)
         w_in = speeds[input_body]
+        if nominal is None and speeds.get("pinion") != 1.0:
+            nominal = abs(w_in) / (2 * math.pi)
         ratios = {body: w / w_in for body, w in speeds.items()}
         gears = tuple(_gears(stages, ratios))
         bearings = tuple(_bearings(scenario, ratios))
-        return cls(str(scenario.meta.name or ""), ratios, stages, gears, bearings, input_body)
+        return cls(str(scenario.meta.name or ""), ratios, stages, gears, bearings, input_body, nominal)
 
     # -- speeds and angles ---------------------------------------------------------------------------
     def bodies(self) -> list[str]:

@@ -68,15 +68,43 @@ def shaft_angles(recording: Recording, drive: DriveKinematics) -> ShaftAngles:
             ch = recording.channel(tacho.channel)
             pulses = pulse_times(ch.data, recording.sample_rate_hz, level=tacho.level, t0_s=recording.t0_s)
             source = "pulse channel"
-        angle = shaft_angle_from_pulses(pulses, tacho.pulses_per_rev, t)
+        _check_pulses(pulses, tacho.pulses_per_rev, ratio, drive, tacho.channel or "the tacho's pulse times")
+        angle = shaft_angle_from_pulses(pulses, tacho.pulses_per_rev, t, method="pchip")
     return ShaftAngles(t, angle / ratio, drive, source)
+
+
+IRREGULAR_FRACTION = 0.05
+"""Share of consecutive pulse intervals differing by more than 2x above which a tacho is refused."""
+MAX_OVER_NOMINAL = 10.0
+"""Highest input-shaft speed a tacho may imply, over the scenario's nominal speed."""
+
+
+def _check_pulses(pulses: np.ndarray, ppr: int, ratio: float, drive: DriveKinematics, where: str) -> None:
+    """Refuse a tacho whose pulses cannot be a shaft's: irregular (noise triggered), or far faster than
+    the drive turns (a wrong channel, pulses per revolution or shaft)."""
+    hint = "check --tacho (the channel), its trigger level, --pulses-per-rev and --tacho-shaft"
+    intervals = np.diff(pulses)
+    jumps = intervals[1:] / intervals[:-1]
+    irregular = float(np.mean((jumps > 2) | (jumps < 0.5))) if jumps.size else 0.0
+    if irregular > IRREGULAR_FRACTION:
+        raise InputError(
+            f"tacho {where}: {irregular:.0%} of its consecutive pulse intervals differ by more than 2x "
+            f"(allowed {IRREGULAR_FRACTION:.0%}): not a shaft's pulses; {hint}"
+        )
+    fastest_hz = 1.0 / (ppr * float(np.min(intervals))) / ratio
+    nominal = drive.nominal_input_hz
+    if nominal and fastest_hz > MAX_OVER_NOMINAL * nominal:
+        raise InputError(
+            f"tacho {where}: its pulses put the input shaft at up to {fastest_hz:.4g} rev/s, over "
+            f"{MAX_OVER_NOMINAL:g} x the scene's nominal {nominal:.4g} rev/s; {hint}"
+        )
 
 
 def _tacholess(recording: Recording, drive: DriveKinematics) -> ShaftAngles:
     from ..analysis.tacholess import tacholess_angle
 
     gear = drive.gears[0]
-    speed = recording.meta.get("input_speed_hz")
+    speed = recording.meta.get("input_speed_hz") or drive.nominal_input_hz
     if not speed:
         raise InputError(
             "the recording has no tacho: give one (--tacho CHANNEL or a tacho in the file), or its input "
@@ -91,5 +119,9 @@ def _tacholess(recording: Recording, drive: DriveKinematics) -> ShaftAngles:
         speed_guess_hz=float(speed) * ratio,
         t0_s=recording.t0_s,
     )
-    note = f"tacholess: shaft angle from the {gear.teeth}x mesh harmonic of {gear.body} on {channel!r}"
+    guess = "given" if recording.meta.get("input_speed_hz") else "the scene's nominal"
+    note = (
+        f"tacholess: shaft angle from the {gear.teeth}x mesh harmonic of {gear.body} on {channel!r}, "
+        f"searched near the {guess} input speed {float(speed):.4g} rev/s"
+    )
     return ShaftAngles(recording.time_s, np.asarray(found.angle_rad) / ratio, drive, "tacholess", note)
