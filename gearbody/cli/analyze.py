@@ -18,7 +18,8 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
         "--channel",
         action="append",
         metavar="NAME",
-        help="channel to analyse (repeatable; default: the vibration channels, at most 4)",
+        help="channel to analyse (repeatable; default: a run's vibration signal, a file's vibration "
+        "channels, at most 4)",
     )
     parser.add_argument(
         "--tacho",
@@ -59,7 +60,7 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
         type=number(gt=0),
         metavar="HZ",
         help="without a tacho: the input shaft's approximate speed [rev/s] for the tacholess "
-        "estimate from the mesh harmonic",
+        "estimate from the mesh harmonic (default: the scene's nominal speed)",
     )
     parser.add_argument("--start", type=number(ge=0), metavar="SECONDS", help="analyse from this time")
     parser.add_argument("--end", type=number(gt=0), metavar="SECONDS", help="analyse up to this time")
@@ -78,7 +79,7 @@ def register(sub) -> argparse.ArgumentParser:
             "shaft with FM0, FM4, NA4, M6A, M8A and the energy ratio; fault-band metrics; the kurtogram "
             "and the squared-envelope spectrum in its band. Every shaft's angle comes from one tacho "
             "through the scene's ratios (or, without a tacho, from the first mesh harmonic near "
-            "--input-speed)."
+            "--input-speed, default the scene's nominal speed)."
         ),
     )
     p.add_argument("recording", metavar="RECORDING", help="recording file, or a run's result.npz or folder")
