@@ -196,3 +196,16 @@ def test_a_noise_tacho_and_a_dead_channel_are_refused_or_said():
     assert list(diag.channels) == ["acc"] and "channel 'dead' is constant" in diag.notes[-1]
     with pytest.raises(gb.InputError, match="every channel asked for is constant"):
         analyze_recording(dead, drive, ["dead"])
+
+
+@pytest.mark.slow
+def test_sensitivity_ranks_keys_by_the_misfit_to_a_recordings_feature(run_folder, tmp_path):
+    """--target-from: the output is the misfit (value - target) / sigma of a recording's feature,
+    computed on every run by the same analysis."""
+    assert main(["analyze", str(run_folder), "--out", str(tmp_path / "a")]) == 0
+    args = ["sensitivity", "lateral-8dof", "--key", "condition.friction_coefficient=0.0:0.1",
+            "--target-from", str(tmp_path / "a"), "fm0:pinion", "0.1", "--samples", "2", "--t-end", "0.4",
+            "--workers", "1", "--quiet", "--out", str(tmp_path / "s")]  # fmt: skip
+    assert main(args) == 0
+    indices = (tmp_path / "s" / "indices.csv").read_text()
+    assert "recording:feature=fm0:pinion" in indices and "target=" in indices

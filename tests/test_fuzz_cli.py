@@ -67,6 +67,8 @@ BASE = {
     + ["--polish-evaluations", "0", "--t-end", "0.003", "--workers", "1", "--quiet", "--out", "out"],
     "render": ["--kinematic", "--frames", "1", "--format", "none", "--width", "32", "--height", "24"]
     + ["--quiet", "--out", "out"],
+    "analyze": ["--out", "out"],
+    "compare": ["--out", "out"],
 }
 VALIDATE_SCENE = "two-wheel"  # validate simulates each case twice (gearbody and the reference): the cheapest
 
@@ -109,6 +111,10 @@ RESULT_FILES = [
     "/dev/zero", "folder", "symlink-loop", "missing", "empty-name", "binary",
 ]  # fmt: skip
 """``render --result`` kinds."""
+RECORDING_FILES = [
+    "rec-h5", "rec-wav", "rec-csv", "rec-csv-nan", "rec-csv-ragged", "rec-wav-empty", "run-folder", "run-npz",
+]  # fmt: skip
+"""``analyze`` / ``compare`` RECORDING kinds (a logger's files, good and bad, and a run)."""
 OUT_PATHS = [
     "fresh", "nested-fresh", "existing-file", "fifo", "symlink-loop", "broken-symlink", "dir-with-junk",
     "through-file", "long-name", "newline-name", "empty-name", "dot", "symlink-to-folder", "non-utf8-name",
@@ -195,6 +201,8 @@ def make(kind: str, folder: Path, scene: str = "one-stage") -> str:
     elif kind == "non-utf8-name":
         p = folder / "\udcff.toml"
         p.write_text(_scene_text(scene))
+    elif kind.startswith(("rec-", "run-")):
+        return make_recording(kind, folder)
     elif kind.startswith("npz-"):
         import numpy as np
 
@@ -211,6 +219,56 @@ def make(kind: str, folder: Path, scene: str = "one-stage") -> str:
     else:
         raise ValueError(kind)
     return os.path.relpath(p, folder) if kind != "long-name" else str(p.name)
+
+
+_RUN: list[Path] = []
+
+
+def _run_folder() -> Path:
+    """A short run of two-wheel (made once per process, copied where a test needs it)."""
+    if not _RUN:
+        import tempfile
+
+        import gearbody as gb
+
+        where = Path(tempfile.mkdtemp(prefix="fuzz-run-"))
+        gb.simulate(gb.load_scenario("two-wheel", ["operation.t_end_s=0.3"])).save_npz(where / "result.npz")
+        _RUN.append(where)
+    return _RUN[0]
+
+
+def make_recording(kind: str, folder: Path) -> str:
+    """A recording of ``kind`` in ``folder``: a logger's file (HDF5, WAV, CSV; good, with NaN, ragged,
+    empty) or a run (its folder or result.npz); its text on the command line."""
+    import numpy as np
+
+    fs = 5000.0
+    t = np.arange(int(2 * fs)) / fs
+    acc = np.sin(2 * np.pi * 29 * 17.3 * t) + 0.1 * np.sin(2 * np.pi * 17.3 * t)
+    tacho = (np.mod(17.3 * t, 1.0) < 0.05).astype(float)
+    if kind == "rec-h5":
+        from gearbody.recording import Channel, Recording
+        from gearbody.recording.files import write_recording
+
+        rec = Recording(fs, [Channel("acc", acc, "m/s^2"), Channel("tacho", tacho, "V")])
+        return write_recording(rec, folder / "rec.h5").name
+    if kind in ("rec-wav", "rec-wav-empty"):
+        from scipy.io import wavfile
+
+        data = np.stack([acc / 2, tacho], axis=1)[: 0 if kind == "rec-wav-empty" else None]
+        wavfile.write(folder / "rec.wav", int(fs), np.round(data * 32767).astype(np.int16))
+        return "rec.wav"
+    if kind.startswith("rec-csv"):
+        rows = [f"{a!r},{b!r},{c!r}" for a, b, c in zip(t, acc, tacho, strict=True)]
+        if kind == "rec-csv-nan":
+            rows[100] = f"{t[100]!r},nan,0.0"
+        elif kind == "rec-csv-ragged":
+            rows[100] = f"{t[100]!r},1.0"
+        (folder / "rec.csv").write_text("time_s,acc [m/s^2],tacho [V]\n" + "\n".join(rows) + "\n")
+        return "rec.csv"
+    run = next(folder / f"run{k}" for k in range(100) if not (folder / f"run{k}").exists())
+    shutil.copytree(_run_folder(), run)
+    return run.name if kind == "run-folder" else os.path.join(run.name, "result.npz")
 
 
 def make_out(kind: str, folder: Path) -> str:
@@ -312,6 +370,26 @@ def paths(kinds: list[str]):
     return st.sampled_from(kinds).map(File)
 
 
+def recording_options() -> dict:
+    """The options of analyze and compare that say how to read a recording."""
+    n, c = st.sampled_from(NUMBERS), st.sampled_from(COUNTS)
+    return {
+        "--scene": st.one_of(st.sampled_from(SCENES), st.sampled_from(TEXTS), paths(SCENARIO_FILES)),
+        "--channel": st.sampled_from([*TEXTS, "acc", "tacho", "ch1", "pinion_accel_rad_s2"]),
+        "--tacho": st.sampled_from([*TEXTS, "tacho", "ch2", "acc"]),
+        "--pulses-per-rev": c,
+        "--tacho-shaft": st.sampled_from(["input", "output", "pinion", "wheel", "motor", "", "x", "wheel_9"]),
+        "--unit": st.sampled_from(["acc=g", "acc=furlong", "=", "acc", "ch1=g", "tacho=rad", "x=m"]),
+        "--calibration": st.sampled_from([*NUMBERS, "1,2", "1,,2", "1,2,3"]),
+        "--sample-rate": n,
+        "--input-speed": n,
+        "--start": n,
+        "--end": n,
+        "--no-envelope": st.none(),
+        "--prewhiten": st.none(),
+    }
+
+
 @dataclass(frozen=True)
 class Option:
     """An option of a command and the values drawn for it (strings, a File, or a list: nargs > 1)."""
@@ -401,6 +479,8 @@ def options(command: str) -> list[Option]:
                 ["1,1,1", "0,0,0", "2,0,0", "nan,0,0", "1,1", "1,1,1,1", "", "a,b,c"]
             ),
         },
+        "analyze": recording_options(),
+        "compare": {**recording_options(), "--run-channel": st.sampled_from([*TEXTS, "pinion_accel_rad_s2"])},
     }[command]
     names = {**common, **own}
     if command == "validate":  # the cheap cases only: --short stays, the one scene runs
@@ -428,6 +508,15 @@ def command_lines(draw, command: str) -> list:
     odd = draw(st.integers(0, 7)) == 0
     if command == "validate":
         tokens.append(draw(paths(SCENARIO_FILES)) if odd else VALIDATE_SCENE)
+    elif command == "analyze":  # a recording (odd: any odd file) on a scene
+        tokens += [
+            draw(paths(SCENARIO_FILES if odd else RECORDING_FILES)),
+            "--scene",
+            draw(st.sampled_from(SCENES)),
+        ]
+    elif command == "compare":  # a run (odd: any odd file or recording) beside a recording
+        first = paths([*SCENARIO_FILES, *RECORDING_FILES]) if odd else st.just(File("run-folder"))
+        tokens += [draw(first), draw(paths(RECORDING_FILES))]
     elif command not in ("list", "info"):
         tokens.append(draw(paths(SCENARIO_FILES)) if odd else draw(st.sampled_from(SCENES)))
     tokens += BASE[command] + _wall(command)
@@ -497,7 +586,7 @@ COMMAND_NAMES = [
 ]
 EXAMPLES = {
     "list": 4, "info": 2, "new": 10, "run": 14, "modes": 10, "mesh": 10, "validate": 2, "sweep": 8,
-    "sensitivity": 6, "calibrate": 6, "render": 10,
+    "sensitivity": 6, "calibrate": 6, "render": 10, "analyze": 10, "compare": 6,
 }  # fmt: skip
 
 
@@ -528,7 +617,17 @@ def test_every_scenario_file_kind_on_every_command_ends_cleanly(runner, kind):
         check(runner, ["run", File(kind), *BASE["run"], *_wall("run")], f"file {kind}", {"ok"})
         return
     for command in [c for c in COMMAND_NAMES if c not in ("list", "info")]:  # the ones that read a scenario
-        check(runner, [command, File(kind), *BASE[command], *_wall(command)], f"file {kind}", {"refused"})
+        where = {"analyze": ["--scene", File(kind)], "compare": ["--scene", File(kind)]}.get(command, [])
+        first = {"analyze": [File("rec-h5")], "compare": [File("run-folder"), File("rec-h5")]}
+        tokens = [command, *first.get(command, [File(kind)]), *where, *BASE[command], *_wall(command)]
+        check(runner, tokens, f"file {kind}", {"refused"})
+        if command in first:  # the odd file as the recording (compare: as the run) too
+            tokens = [
+                command,
+                File(kind),
+                *(["--scene", "one-stage"] if command == "analyze" else [File("rec-h5")]),
+            ]
+            check(runner, [*tokens, *BASE[command]], f"recording {kind}", {"refused"})
 
 
 @pytest.mark.parametrize("kind", OUT_PATHS)

@@ -111,10 +111,20 @@ def open_recording(args, path: str | None = None, need_scenario: bool = True):
     from gearbody.errors import InputError
     from gearbody.model import load_scenario
 
-    source = Path(path or args.recording)
-    if not source.exists():
-        raise InputError(f"RECORDING {source}: no such file or folder")
-    if source.is_dir() or source.suffix == ".npz":
+    text = str(args.recording if path is None else path)
+    label = "RECORDING" if path is None else "RUN"
+    source = Path(text)
+    if getattr(args, "scene", None) is not None and not args.scene.strip():
+        raise InputError("--scene '': give a scene name or a .toml scenario")
+    if not text.strip():
+        raise InputError(f"{label} '': give a file, or a run's folder or result.npz")
+    try:
+        found, folder = source.exists(), source.is_dir()
+    except OSError as exc:  # a name the system cannot even look up (too long)
+        raise InputError(f"{label} {source}: cannot be used: {exc.strerror or exc}") from None
+    if not found:
+        raise InputError(f"{label} {source}: no such file or folder")
+    if folder or source.suffix == ".npz":
         rec = _run_recording(source, args)
     else:
         from gearbody.recording.files import read_recording
@@ -151,7 +161,7 @@ def open_recording(args, path: str | None = None, need_scenario: bool = True):
         scenario = None
     else:
         raise InputError(
-            f"RECORDING {source}: a measured recording needs --scene (the drive it was recorded on)"
+            f"{label} {source}: a measured recording needs --scene (the drive it was recorded on)"
         )
     return rec, scenario
 
@@ -202,7 +212,7 @@ def _run_recording(source: Path, args):
         )
     npz = source / "result.npz" if source.is_dir() else source
     if not npz.is_file():
-        raise InputError(f"RECORDING {source}: a folder must hold a run's result.npz")
+        raise InputError(f"{source}: a folder must hold a run's result.npz")
     result = Result.load_npz(npz)
     shaft = args.tacho_shaft if args.tacho_shaft not in (None, "input", "output") else None
     if shaft is None:
