@@ -204,7 +204,10 @@ def test_sensitivity_ranks_keys_by_the_misfit_to_a_recordings_feature(run_folder
     computed on every run by the same analysis."""
     assert main(["analyze", str(run_folder), "--out", str(tmp_path / "a")]) == 0
     args = ["sensitivity", "lateral-8dof", "--key", "condition.friction_coefficient=0.0:0.1",
-            "--target-from", str(tmp_path / "a"), "fm0:pinion", "0.1", "--samples", "2", "--t-end", "0.4",
+            "--target-from", str(tmp_path / "a"), "fm0:pinion", "0.1", "--samples", "2", "--t-end", "0.8",
+            "--set", 'operation.initial_state="steady"',
+            "--set", "operation.speed_profile={time_s=[0.0],fraction=[1.0]}",
+            "--set", "operation.load_profile={time_s=[0.0],fraction=[1.0]}",
             "--workers", "1", "--quiet", "--out", str(tmp_path / "s")]  # fmt: skip
     assert main(args) == 0
     indices = (tmp_path / "s" / "indices.csv").read_text()
