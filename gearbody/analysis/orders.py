@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ._validate import integer_at_least, is_real, positive_frequency
+from ._validate import finite_1d, integer_at_least, is_real, positive_frequency, strictly_increasing_angle
 
 __all__ = [
     "MAX_DEFAULT_SAMPLES_PER_REV",
@@ -54,18 +54,6 @@ _CHUNK_SAMPLES = 2**18
 """Input samples per chunk of the resampling."""
 _SPLINE_MARGIN = 32
 """Upsampled samples beyond the filter margin for the B-spline prefilter to settle (its poles <= 0.43)."""
-
-
-def _as_1d(name: str, values: ArrayLike, min_size: int = 2) -> NDArray[np.float64]:
-    array = np.asarray(values, dtype=float)
-    if array.ndim != 1:
-        raise InputError(f"{name} must be 1-D, got shape {array.shape}")
-    if array.size < min_size:
-        raise InputError(f"{name} must hold at least {min_size} values, got {array.size}")
-    if not np.all(np.isfinite(array)):
-        first = int(np.flatnonzero(~np.isfinite(array))[0])
-        raise InputError(f"{name} must be finite, sample {first} is {array[first]!r}")
-    return array
 
 
 def _positive(name: str, value: float | None, unit: str) -> float | None:
@@ -117,13 +105,7 @@ class OrderTrackedSignal:
 def _check_angle(angle: NDArray[np.float64], n: int) -> None:
     if angle.size != n:
         raise InputError(f"signal and shaft_angle_rad must have equal lengths, got {n} and {angle.size}")
-    step = np.diff(angle)
-    if np.any(step <= 0.0):
-        i = int(np.flatnonzero(step <= 0.0)[0])
-        raise InputError(
-            "shaft_angle_rad must be strictly increasing (unwrapped, rotation in the positive sense): "
-            f"sample {i + 1} is {angle[i + 1]!r} rad after {angle[i]!r} rad at sample {i}"
-        )
+    strictly_increasing_angle(angle)
 
 
 def _grid_and_band(
@@ -262,9 +244,9 @@ def order_track(
         upsample: upsampling factor before the interpolation (>= 2).
         t0_s: time of the first sample [s].
     """
-    x = _as_1d("signal", signal, 4)
+    x = finite_1d("signal", signal, 4)
     fs = positive_frequency("sample_rate_hz", sample_rate_hz)
-    angle = _as_1d("shaft_angle_rad", shaft_angle_rad, 4)
+    angle = finite_1d("shaft_angle_rad", shaft_angle_rad, 4)
     _check_angle(angle, x.size)
     max_order = _positive("max_order", max_order, "cycles/rev")
     upsample = integer_at_least("upsample", upsample, 2)

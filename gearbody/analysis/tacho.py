@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ._validate import integer_at_least, is_real, positive_frequency
+from ._validate import finite_1d, integer_at_least, is_real, positive_frequency
 
 __all__ = ["pulse_times", "shaft_angle_from_pulses", "shaft_speed_from_pulses"]
 
@@ -27,18 +27,6 @@ _LEVEL_PERCENTILES = (0.5, 99.5)
 record, e.g. a very narrow keyphasor pulse, needs an explicit ``level``)."""
 _DEFAULT_HYSTERESIS = 0.1
 """Default hysteresis as a fraction of the robust range (high state - low state)."""
-
-
-def _as_1d(name: str, values: ArrayLike, min_size: int) -> NDArray[np.float64]:
-    array = np.asarray(values, dtype=float)
-    if array.ndim != 1:
-        raise InputError(f"{name} must be 1-D, got shape {array.shape}")
-    if array.size < min_size:
-        raise InputError(f"{name} must hold at least {min_size} values, got {array.size}")
-    if not np.all(np.isfinite(array)):
-        first = int(np.flatnonzero(~np.isfinite(array))[0])
-        raise InputError(f"{name} must be finite, value {first} is {array[first]!r}")
-    return array
 
 
 def _finite_real(name: str, value: float) -> float:
@@ -94,7 +82,7 @@ def pulse_times(
         edge: "rising" or "falling".
         t0_s: time of the first sample [s].
     """
-    x = _as_1d("tacho_signal", tacho_signal, 2)
+    x = finite_1d("tacho_signal", tacho_signal, 2)
     fs = positive_frequency("sample_rate_hz", sample_rate_hz)
     t0_s = _finite_real("t0_s", t0_s)
     if edge not in ("rising", "falling"):
@@ -120,7 +108,7 @@ def pulse_times(
 def _pulse_angles(pulse_times_s: ArrayLike, pulses_per_rev: int) -> tuple[NDArray, NDArray]:
     """Validated pulse instants [s] and the shaft angle of each [rad]."""
     pulses_per_rev = integer_at_least("pulses_per_rev", pulses_per_rev, 1)
-    t = _as_1d("pulse_times_s", pulse_times_s, 3)
+    t = finite_1d("pulse_times_s", pulse_times_s, 3)
     step = np.diff(t)
     if np.any(step <= 0):
         i = int(np.flatnonzero(step <= 0)[0])

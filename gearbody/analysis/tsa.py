@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from ._validate import strictly_increasing_angle
 
 __all__ = [
     "MAX_DEFAULT_POINTS_PER_REV",
@@ -84,13 +85,7 @@ def _signal_and_angle(
         raise InputError(f"signal and shaft_angle_rad must have equal lengths, got {y.size} and {angle.size}")
     if angle.size < 2:
         raise InputError(f"shaft_angle_rad must have at least 2 samples, got {angle.size}")
-    step = np.diff(angle)
-    if np.any(step <= 0.0):
-        i = int(np.flatnonzero(step <= 0.0)[0])
-        raise InputError(
-            "shaft_angle_rad must be strictly increasing (unwrapped, rotation in the positive sense): "
-            f"sample {i + 1} is {angle[i + 1]!r} rad after {angle[i]!r} rad at sample {i}"
-        )
+    strictly_increasing_angle(angle)
     first_rev = np.ceil(angle[0] / _TWO_PI - _REV_TOL)
     start_rad = _TWO_PI * first_rev + 0.0  # + 0.0 turns -0.0 into 0.0
     n_revs = int(np.floor((angle[-1] - start_rad) / _TWO_PI + _REV_TOL))
