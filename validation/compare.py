@@ -67,6 +67,31 @@ SEPARATION_SPEED = {
 NO_RUN_UP = ("lateral-8dof-ball", "planetary", "planetary-conveyor")
 """Planetary scenes: steady and separation cases (issue 19); a run-up of the reference at ~250 s per
 simulated second (2N segmented meshes) is left to validation/ scripts."""
+BEARING_DEFECT = {
+    # lateral-8dof-ball's bearings ball by ball ('rolling-elements', per-ball K from the lumped k_b by
+    # Stribeck's Z K / 4.37; cage slip 1.5 %), a 20 um outer-race spall in the pinion bearing's load zone
+    # and a ball defect, a 20 um inner-race spall on the wheel's (docs/scenario.md, "Bearing defects")
+    "lateral-8dof-ball": tuple(
+        f"design.stages.1.{gear}.bearing.{key}"
+        for gear, k_ball, damping, defects in (
+            (
+                "pinion",
+                5.5e10,
+                2000.0,
+                '[{race="outer",depth_m=20e-6,width_deg=6.0,angle_deg=90.0},'
+                '{race="ball",depth_m=20e-6,width_deg=20.0,angle_deg=30.0,ball=3}]',
+            ),
+            ("wheel", 1.1e11, 4000.0, '[{race="inner",depth_m=20e-6,width_deg=8.0,angle_deg=45.0}]'),
+        )
+        for key in (
+            'kind="rolling-elements"',
+            f"parameters={{ball_stiffness_N_per_m_n={k_ball},radial_clearance_m=5e-6,damping_Ns_per_m={damping},"
+            "cage_slip=0.015,slip_seed=7}",
+            f"defects={defects}",
+        )
+    ),
+}
+"""Scenes with a bearing-defect case: overrides that make their bearings ball by ball with defects."""
 SHORT_S = {"planetary": (0.04, 0.06), "planetary-conveyor": (0.04, 0.06)}
 """(steady, separation) short-run lengths where the default ones would make the suite slow, s."""
 
@@ -147,6 +172,9 @@ def cases(scene: str, short: bool = False) -> list[Case]:
     ]
     if scene not in NO_RUN_UP:
         out.append(Case("run-up", run_up_text, tuple(run_up), 1.0, 0.4, no_backlash=scene != "muller"))
+    if scene in BEARING_DEFECT:
+        text = "steady rated, ball-by-ball bearings: outer-race and ball defects (pinion), inner-race (wheel)"
+        out.append(Case("bearing-defect", text, (*steady, *BEARING_DEFECT[scene]), 0.5, 0.1))
     return out
 
 

@@ -172,7 +172,8 @@ def bearing_law_forces(link: PlanetaryLink, q_rel: np.ndarray, q_t: np.ndarray) 
     for m, member in enumerate(lay.members):
         if member.bearing_law is not None:
             o = 3 * m
-            f[o : o + 2] += member.bearing_law.force_N(q_rel[o : o + 2], q_t[o : o + 2])
+            turn = (q_rel[o + 2],) if getattr(member.bearing_law, "ROTATING", False) else ()  # its inner race
+            f[o : o + 2] += member.bearing_law.force_N(q_rel[o : o + 2], q_t[o : o + 2], *turn)
     law = lay.planet.bearing_law
     if law is None:
         return f
@@ -190,7 +191,8 @@ def bearing_law_forces(link: PlanetaryLink, q_rel: np.ndarray, q_t: np.ndarray) 
         vy = q_t[b + 1] - (vyc + rc * c * wc)
         u = np.array([c * ex + s_ * ey, -s_ * ex + c * ey])  # carrier frame: radial, tangential
         du = np.array([c * vx + s_ * vy, -s_ * vx + c * vy])
-        fr, ft = law.force_N(u, du)
+        turn = (0.0, q_rel[b + 2] - tc) if getattr(law, "ROTATING", False) else ()  # pin inner, planet outer
+        fr, ft = law.force_N(u, du, *turn)
         Fx, Fy = c * fr - s_ * ft, s_ * fr + c * ft  # on the planet, fixed frame
         f[b] += Fx
         f[b + 1] += Fy

@@ -102,11 +102,14 @@ class MeshItem:
 @dataclass(frozen=True)
 class BearingItem:
     """A bearing law (``force_N(u, u')``, optionally ``force_xy``) between a planar body's centre and the
-    ground, acting in ``free_directions`` (0 = x, 1 = y)."""
+    ground, acting in ``free_directions`` (0 = x, 1 = y); a law that turns with the gear (``ROTATING``)
+    gets its rotation times ``rotation_sense`` (+1: the coordinate turns counter-clockwise about +z) as
+    the inner race's angle."""
 
     body: int
     law: object = field(repr=False)
     free_directions: tuple[int, ...] = (0, 1)
+    rotation_sense: float = 1.0
 
 
 @dataclass(frozen=True)

@@ -41,6 +41,7 @@ class LateralSupport:
     bearing: object = field(repr=False)  # a gearbody.physics.bearings law (force_N method)
     bearing_kind: str = "linear"
     housing_mass_kg: float = 50.0
+    rotation_sense: float = 1.0  # +1: the gear's rotation coordinate turns counter-clockwise (about +z)
 
 
 @dataclass(frozen=True)
@@ -112,11 +113,11 @@ def torsional_layout(scenario: Scenario) -> TorsionalLayout:
     meshes = []
     for k, st in enumerate(stages):
         pname, wname = gear_names(k)
+        n, m, s1 = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
         inertias += [
-            Inertia(pname, st.pinion.inertia_kg_m2, _support(st.pinion)),
-            Inertia(wname, st.wheel.inertia_kg_m2, _support(st.wheel)),
+            Inertia(pname, st.pinion.inertia_kg_m2, _support(st.pinion, s1)),
+            Inertia(wname, st.wheel.inertia_kg_m2, _support(st.wheel, -s1)),
         ]
-        n, m, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
         meshes.append(
             MeshLink(
                 2 * k + 1,
@@ -138,7 +139,8 @@ def torsional_layout(scenario: Scenario) -> TorsionalLayout:
     )
 
 
-def _support(gear) -> LateralSupport | None:
+def _support(gear, rotation_sense: int) -> LateralSupport | None:
+    """A lateral gear's support; ``rotation_sense`` its rotation's sense about +z (pinion s1, wheel -s1)."""
     if gear.lateral == "none":
         return None
     return LateralSupport(
@@ -147,6 +149,7 @@ def _support(gear) -> LateralSupport | None:
         gear.bearing.law(),
         gear.bearing.kind,
         gear.bearing.housing_mass_kg,
+        float(rotation_sense),
     )
 
 
@@ -264,7 +267,7 @@ def _bearing_items(body: int, first: int, b: Inertia, lateral_u0, modal: bool) -
         K[:2, :2] = tangent_stiffness_N_per_m(law, lateral_u0.get(b.name, np.zeros(2)))
         items.append(MatrixItem((body,), K))
     else:
-        items.append(BearingItem(body, law, sup.free_directions))
+        items.append(BearingItem(body, law, sup.free_directions, sup.rotation_sense))
     return items
 
 

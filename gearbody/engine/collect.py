@@ -301,7 +301,7 @@ def _lateral_signals(scenario, names, q, v, a, signals) -> dict[str, np.ndarray]
     for k, st in enumerate(scenario.stages):  # lateral gears are never combined with planetary stages
         prefix = stage_prefix(k)
         F, T = signals[prefix + "mesh_force_N"], signals[prefix + "friction_force_N"]
-        n, m, _ = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
+        n, m, s1 = mesh_directions(st.mesh.centre_line_deg, st.mesh.line_of_action_deg)
         for name, gear, sign in zip(gear_names(k), (st.pinion, st.wheel), (1.0, -1.0), strict=True):
             if gear.lateral == "none":
                 continue
@@ -310,6 +310,9 @@ def _lateral_signals(scenario, names, q, v, a, signals) -> dict[str, np.ndarray]
             law = gear.bearing.law()
             if isinstance(law, LinearBearing):
                 f_b = law.force_N(u, du)
+            elif getattr(law, "ROTATING", False):  # the gear's rotation turns the inner race
+                turn = sign * s1 * q[names.index(name)]  # counter-clockwise about +z
+                f_b = np.array([law.force_N(u[:, s], du[:, s], turn[s]) for s in range(u.shape[1])]).T
             else:
                 f_b = np.array([law.force_N(u[:, s], du[:, s]) for s in range(u.shape[1])]).T
             for d, axis in enumerate("xy"):

@@ -252,7 +252,8 @@ def item_terms(item, layout: SystemLayout) -> list[tuple[object, np.ndarray]]:
     if isinstance(item, BearingItem):
         mask = [float(d in item.free_directions) for d in (0, 1)]
         if hasattr(item.law, "law_row"):  # a shipped law, by its row
-            return [(K.bearing_law_kernel, K.pack([*mask, float(at[0])], item.law.law_row()))]
+            at_sense = [*mask, float(at[0]), float(item.rotation_sense)]
+            return [(K.bearing_law_kernel, K.pack(at_sense, item.law.law_row()))]
         raise NotCompiled(f"the bearing law {type(item.law).__name__} has no law_row() for the compiled path")
     if isinstance(item, TorqueItem):
         kernel = K.motor_kernel if item.role == "motor" else K.load_kernel

@@ -106,7 +106,7 @@ def _python_function(item, layout: SystemLayout, watchdog: StallWatchdog) -> tup
             return item.bodies, mesh_user_function(item.parameters)
         return item.bodies, lateral_mesh_user_function(item.parameters, item.geometry, item.index)
     if isinstance(item, BearingItem):
-        return (item.body,), bearing_user_function(item.law, item.free_directions)
+        return (item.body,), bearing_user_function(item.law, item.free_directions, item.rotation_sense)
     if isinstance(item, TorqueItem):
         if item.role == "motor":
             return (item.body,), motor_user_function(item.drive, watchdog)

@@ -93,8 +93,12 @@ def _stage_signals(
         ix = names.index(name + "_x")
         law = member.bearing_law
         if law is not None:
+            turn = q[ix + 2] if getattr(law, "ROTATING", False) else None  # the member turns the inner race
             on_member = np.array(
-                [law.force_N(q[ix : ix + 2, i], v[ix : ix + 2, i]) for i in range(q.shape[1])]
+                [
+                    law.force_N(q[ix : ix + 2, i], v[ix : ix + 2, i], *(() if turn is None else (turn[i],)))
+                    for i in range(q.shape[1])
+                ]
             ).T
         for d, axis in enumerate("xy"):
             u, du = q[ix + d], v[ix + d]

@@ -42,9 +42,17 @@ def lateral_mesh_user_function(P: np.ndarray, geometry: np.ndarray, idx: np.ndar
     return lateral_mesh_force
 
 
-def bearing_user_function(law, free_directions: tuple[int, ...]):
+def bearing_user_function(law, free_directions: tuple[int, ...], rotation_sense: float = 1.0):
     mask = np.array([float(d in free_directions) for d in (0, 1)])
     mx, my = float(mask[0]), float(mask[1])
+    if getattr(law, "ROTATING", False):  # the gear's rotation turns the inner race (outer in the housing)
+        force_turning, sense = law.force_xy, float(rotation_sense)
+
+        def bearing_force_turning(mbs, t, itemNumber, q, q_t):
+            fx, fy = force_turning(q[0] * mx, q[1] * my, q_t[0] * mx, q_t[1] * my, q[2] * sense, 0.0)
+            return [fx * mx, fy * my, 0.0]
+
+        return bearing_force_turning
     if hasattr(law, "force_xy"):
         force_xy = law.force_xy
 

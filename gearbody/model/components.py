@@ -38,7 +38,8 @@ class Shaft(Node):
 @dataclass(frozen=True, kw_only=True)
 class RollingGeometry(Node):
     """The geometry of a rolling-element bearing that sets its defect frequencies (BPFO, BPFI, BSF, FTF):
-    data for the analysis only; no bearing law reads it, so it never changes a run."""
+    the ball-by-ball law ``"rolling-elements"`` reads it; for the other laws it is data for the analysis
+    only and never changes a run."""
 
     balls: int = param(ge=3, le=100, doc="number of rolling elements (balls or rollers) N")
     ball_diameter_m: float = param(gt=0, doc="rolling-element diameter d (< pitch_diameter_m)")
@@ -58,6 +59,27 @@ class RollingGeometry(Node):
 
 
 @dataclass(frozen=True, kw_only=True)
+class BearingDefectSpec(Node):
+    """A local defect of a ``"rolling-elements"`` bearing (gearbody.physics.rolling_bearing): a pit of
+    ``depth_m`` over ``width_deg`` on the outer race (fixed in the housing), the inner race (turning with
+    the gear) or a ball, at ``angle_deg``."""
+
+    race: str = param(choices=("outer", "inner", "ball"), doc="where the defect is: outer, inner or ball")
+    depth_m: float = param(gt=0, le=0.01, doc="depth of the pit (the drop is also limited by the ball)")
+    width_deg: float = param(
+        gt=0, le=90, doc="angular width (about the bearing centre; a ball defect: about the ball's centre)"
+    )
+    angle_deg: float = param(
+        0.0,
+        ge=-360,
+        le=360,
+        doc="outer: from the housing's x axis; inner: on the inner race from the gear's zero angle; ball: "
+        "spin angle from the outward radial direction, at the start",
+    )
+    ball: int = param(0, ge=0, le=99, doc="the defective ball (race 'ball'), 0 .. balls - 1")
+
+
+@dataclass(frozen=True, kw_only=True)
 class Bearing(Node):
     """Bearing between a gear centre and the housing: a registered law (gearbody.physics.bearings)
     with its keyword parameters, the effective housing mass seen at this bearing and, optionally, its
@@ -71,14 +93,48 @@ class Bearing(Node):
     )
     parameters: dict[str, float] = param(default_factory=dict, doc="keyword parameters of the law")
     geometry: RollingGeometry | None = param(
-        None, doc="rolling-element geometry for the defect frequencies (data only: no effect on a run)"
+        None,
+        doc="rolling-element geometry: read by the 'rolling-elements' law, for the other laws data for "
+        "the defect frequencies only",
+    )
+    defects: tuple[BearingDefectSpec, ...] = param(
+        (), doc="local defects of a 'rolling-elements' bearing (race, depth_m, width_deg, angle_deg, ball)"
     )
 
     def __post_init__(self) -> None:
         law = self.law()  # refuse unknown kinds and bad parameters before anything runs
         if dataclasses.is_dataclass(law):  # resolve the law's defaults into the scenario
-            resolved = {f.name: float(getattr(law, f.name)) for f in dataclasses.fields(law)}
-            object.__setattr__(self, "parameters", resolved)
+            own = set(getattr(law, "GEOMETRY", ())) | {"defects"}  # stated in geometry / defects
+            fields = [f.name for f in dataclasses.fields(law) if f.name not in own]
+            object.__setattr__(self, "parameters", {name: float(getattr(law, name)) for name in fields})
+
+    def _table_arguments(self, cls) -> dict:
+        """The law's arguments from the geometry and defects tables (the 'rolling-elements' law)."""
+        reads = getattr(cls, "GEOMETRY", ())
+        if self.defects and not reads:
+            raise ScenarioError(
+                f"bearing.defects: the {self.kind!r} law has no defects; a bearing with local defects is "
+                "kind = 'rolling-elements' (ball by ball, with geometry)"
+            )
+        if not reads:
+            return {}
+        if self.geometry is None:
+            raise ScenarioError(
+                f"bearing.geometry: required by the {self.kind!r} law (balls, ball_diameter_m, "
+                "pitch_diameter_m, contact_angle_deg)"
+            )
+        from ..physics.bearings import BearingDefect
+
+        out = {name: getattr(self.geometry, name) for name in reads}
+        for k, d in enumerate(self.defects):
+            if d.race == "ball" and d.ball >= self.geometry.balls:
+                raise ScenarioError(
+                    f"defects.{k + 1}.ball = {d.ball}: the bearing has balls 0 .. {self.geometry.balls - 1}"
+                )
+        out["defects"] = tuple(
+            BearingDefect(d.race, d.depth_m, d.width_deg, d.angle_deg, d.ball) for d in self.defects
+        )
+        return out
 
     def law(self):
         """The bearing law object (has ``force_N(displacement_m, velocity_m_s)``)."""
@@ -94,15 +150,21 @@ class Bearing(Node):
             law += (
                 " (it is a torsional gear's, lateral = 'none'; a gear that moves takes a law with parameters)"
             )
+        tables = self._table_arguments(cls)
         for name, value in self.parameters.items():  # named as the user wrote them, not as Python's
+            if name in tables:
+                raise ScenarioError(
+                    f"parameters.{name} = {value!r}: the {self.kind!r} law reads it from the bearing's "
+                    f"{'defects' if name == 'defects' else 'geometry'} table"
+                )
             if name not in signature:
                 raise ScenarioError(f"parameters.{name} = {value!r}: not a parameter of {law}")
         for name, p in signature.items():
-            if p.default is p.empty and name not in self.parameters:
+            if p.default is p.empty and name not in self.parameters and name not in tables:
                 hint = "" if self.parameters else f"; a torsional gear's bearing table is kind = {RIGID!r}"
                 raise ScenarioError(f"parameters.{name}: required by {law}{hint}")
         try:
-            return make_bearing(self.kind, **self.parameters)
+            return make_bearing(self.kind, **self.parameters, **tables)
         except TypeError as exc:
             raise ScenarioError(f"bearing.parameters = {self.parameters}: {exc}; {law}") from None
         except ValueError as exc:  # the law's own check: 'LinearBearing.stiffness_x_N_per_m = ...'

@@ -29,6 +29,8 @@ from typing import ClassVar, Protocol, runtime_checkable
 import numpy as np
 from numba import njit
 
+from .rolling_bearing import LAW_ROLLING, BearingDefect, RollingElementBearing, rolling_force_xy
+
 
 @runtime_checkable
 class BearingLaw(Protocol):
@@ -157,16 +159,19 @@ def hertz_force_xy(ux, uy, vx, vy, k_b, clearance_m, exponent, damping_Ns_per_m)
 LAW_LINEAR, LAW_HERTZIAN = 1.0, 2.0
 """Codes of the shipped laws in a law row ``[code, parameters...]`` (a law's ``law_row()``), read by
 :func:`law_force_xy` where a compiled function needs a law chosen at run time (a planetary stage's
-bearings)."""
+bearings); :data:`gearbody.physics.rolling_bearing.LAW_ROLLING` is the ball-by-ball law's."""
 
 
 @njit(cache=True)
-def law_force_xy(row, ux, uy, vx, vy):
-    """Force (N) of the law in ``row`` (:data:`LAW_LINEAR` ``[k_x, k_y, C_x, C_y]`` or
-    :data:`LAW_HERTZIAN` ``[k_b, c, n, C]``) on plain floats: the same arithmetic as the law's
-    ``force_N``."""
+def law_force_xy(row, ux, uy, vx, vy, inner_rad, outer_rad):
+    """Force (N) of the law in ``row`` (:data:`LAW_LINEAR` ``[k_x, k_y, C_x, C_y]``,
+    :data:`LAW_HERTZIAN` ``[k_b, c, n, C]`` or the rolling-element law's row) on plain floats, the races
+    turned by ``inner_rad`` and ``outer_rad`` (read by the rolling-element law only): the same arithmetic
+    as the law's ``force_N``."""
     if row[0] == LAW_LINEAR:
         return -(row[1] * ux + row[3] * vx), -(row[2] * uy + row[4] * vy)
+    if row[0] == LAW_ROLLING:
+        return rolling_force_xy(row, ux, uy, vx, vy, inner_rad, outer_rad)
     return hertz_force_xy(ux, uy, vx, vy, row[1], row[2], row[3], row[4])
 
 
@@ -205,7 +210,26 @@ class RigidBearing:
         )
 
 
-BEARINGS: dict[str, type] = {"linear": LinearBearing, "hertzian": HertzianBearing, "rigid": RigidBearing}
+BEARINGS: dict[str, type] = {
+    "linear": LinearBearing,
+    "hertzian": HertzianBearing,
+    "rolling-elements": RollingElementBearing,
+    "rigid": RigidBearing,
+}
+
+__all__ = [
+    "BEARINGS",
+    "BearingDefect",
+    "BearingLaw",
+    "HertzianBearing",
+    "LinearBearing",
+    "RigidBearing",
+    "RollingElementBearing",
+    "law_force_xy",
+    "make_bearing",
+    "register_bearing",
+    "tangent_stiffness_damping",
+]
 
 
 def register_bearing(kind: str, cls: type) -> None:

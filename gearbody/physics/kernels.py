@@ -107,12 +107,15 @@ def _lateral_mesh(t, n, q, q_t, f, P):
 
 @_kernel("bearing_law_kernel")
 def _bearing_law(t, n, q, q_t, f, P):
-    """P = pack([free x, free y, x coordinate], law row): a bearing law
-    (:func:`gearbody.physics.bearings.law_force_xy`) on a gear's x and y, the directions with free 0 held."""
+    """P = pack([free x, free y, x coordinate, rotation sense], law row): a bearing law
+    (:func:`gearbody.physics.bearings.law_force_xy`) on a gear's x and y, the directions with free 0 held,
+    its rotation turning the inner race."""
     B = block(P)
     m = part(B, 0)
-    mx, my, i = m[0], m[1], int(m[2])
-    fx, fy = law_force_xy(part(B, 1), q[i] * mx, q[i + 1] * my, q_t[i] * mx, q_t[i + 1] * my)
+    mx, my, i, sense = m[0], m[1], int(m[2]), m[3]
+    fx, fy = law_force_xy(
+        part(B, 1), q[i] * mx, q[i + 1] * my, q_t[i] * mx, q_t[i + 1] * my, q[i + 2] * sense, 0.0
+    )
     f[i] += fx * mx
     f[i + 1] += fy * my
 

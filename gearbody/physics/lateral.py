@@ -74,7 +74,7 @@ def static_bearing_displacement_m(law, force_on_gear_N, free_directions: tuple[i
     """Centre displacement u0 at which the bearing balances a static force on the gear (free directions).
 
     Closed forms for the linear and Hertzian laws (docs/scenario.md); any other law is solved with
-    scipy's root finder from the linear guess.
+    scipy's root finder from guesses 1 to 300 um along the force (a law with angles at its angles 0).
     """
     from .bearings import HertzianBearing, LinearBearing
 
@@ -100,9 +100,13 @@ def static_bearing_displacement_m(law, force_on_gear_N, free_directions: tuple[i
         u[free] = x_um * 1e-6
         return (np.asarray(law.force_N(u, np.zeros(2)), float) + f)[free] / scale_N
 
-    guess = f[free] / scale_N  # 1 um along the force
-    sol = root(residual, guess, method="lm", options={"xtol": 1e-15, "ftol": 1e-15})
-    if not sol.success or np.max(np.abs(residual(sol.x))) > 1e-9:
+    for reach_um in (1.0, 3.0, 10.0, 30.0, 100.0, 300.0):  # along the force, beyond any clearance
+        sol = root(
+            residual, reach_um * f[free] / scale_N, method="lm", options={"xtol": 1e-15, "ftol": 1e-15}
+        )
+        if sol.success and np.max(np.abs(residual(sol.x))) <= 1e-9:
+            break
+    else:
         raise ValueError(f"no static equilibrium of the bearing law {law!r} under {f} N: {sol.message}")
     u = np.zeros(2)
     u[free] = sol.x * 1e-6

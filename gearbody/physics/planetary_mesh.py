@@ -341,13 +341,15 @@ def stage_bearing_law_forces(
     coordinates (``q_rel`` displacements from the nominal assembly, ``q_t`` velocities): ``laws`` one
     row per sun, ring, carrier and the planets (``[0, ...]``: the linear bearing, not a law here; else
     :func:`gearbody.physics.bearings.law_force_xy`'s row), ``pins`` one row per planet: pin angle (rad),
-    nominal centre x, y (m). A central member's law takes its centre's motion; a planet's law its offset
-    from its pin in the carrier frame, its force acting on the planet and, reversed, on the carrier."""
+    nominal centre x, y (m). A central member's law takes its centre's motion, its rotation turning the
+    inner race in the fixed outer; a planet's law its offset from its pin in the carrier frame, the pin
+    its inner race and the planet's rotation relative to the carrier its outer, its force acting on the
+    planet and, reversed, on the carrier."""
     f = np.zeros(q_rel.size)
     for m in range(3):
         if laws[m, 0] != 0.0:
             o = 3 * m
-            fx, fy = law_force_xy(laws[m], q_rel[o], q_rel[o + 1], q_t[o], q_t[o + 1])
+            fx, fy = law_force_xy(laws[m], q_rel[o], q_rel[o + 1], q_t[o], q_t[o + 1], q_rel[o + 2], 0.0)
             f[o] += fx
             f[o + 1] += fy
     if laws[3, 0] == 0.0:
@@ -363,8 +365,14 @@ def stage_bearing_law_forces(
         ey = pins[n, 2] + q_rel[b + 1] - (yc + rc * s_)
         vx = q_t[b] - (vxc - rc * s_ * wc)
         vy = q_t[b + 1] - (vyc + rc * c * wc)
-        fr, ft = law_force_xy(
-            laws[3], c * ex + s_ * ey, -s_ * ex + c * ey, c * vx + s_ * vy, -s_ * vx + c * vy
+        fr, ft = law_force_xy(  # in the pin's frame: the pin the inner race, the planet the outer
+            laws[3],
+            c * ex + s_ * ey,
+            -s_ * ex + c * ey,
+            c * vx + s_ * vy,
+            -s_ * vx + c * vy,
+            0.0,
+            q_rel[b + 2] - tc,
         )
         Fx, Fy = c * fr - s_ * ft, s_ * fr + c * ft
         f[b] += Fx

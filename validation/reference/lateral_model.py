@@ -17,6 +17,7 @@ from .integrate import _chunk, _contact_edges, phase_events, slide_events
 from .lateral_scenario import _AXES, as_train, gear_names, mesh_geometry, resolve_lateral_defaults
 from .mesh import _Mesh
 from .modes import _mesh_force, _mode_error, _mode_friction, _slide_mode
+from .rolling_bearing import RollingBearing
 from .scenario import chain_constants, stage_F_rated, stage_view, train_stages
 
 _ETA_R = 1e-15  # event hysteresis on r - c (m)
@@ -38,6 +39,9 @@ class _Gear:
         if self.kind == "linear":
             self.k = (float(par["stiffness_x_N_per_m"]), float(par["stiffness_y_N_per_m"]))
             self.C = (float(par["damping_x_Ns_per_m"]), float(par["damping_y_Ns_per_m"]))
+        elif self.kind == "rolling-elements":  # smooth: no mode; the gear's rotation turns the inner race
+            self.law = RollingBearing(self.bearing)
+            self.turn = (1 if role == "pinion" else 2) + 2 * stage
         else:
             self.kb = float(par["contact_stiffness_N_per_m_n"])
             self.c = float(par["radial_clearance_m"])
@@ -95,6 +99,8 @@ class _LatTrain:
                     pair.append(None)
                     continue
                 gear = _Gear(name, s, role, g, nxt)
+                # its rotation's sense about +z: the pinion's s1, the wheel's -s1 (docs: Geometry)
+                gear.sense = self.geo[s]["s1"] * (1.0 if role == "pinion" else -1.0)
                 nxt += len(gear.axes)
                 self.gears.append(gear)
                 pair.append(gear)
@@ -223,13 +229,24 @@ class _LatTrain:
                     lat_w,
                 )
             )
+        rolling = [  # (offset x | None, offset y | None, rotation index, its sense about +z, law)
+            (
+                g.idx[0] - n_tor if 0 in g.idx else None,
+                g.idx[1] - n_tor if 1 in g.idx else None,
+                g.turn,
+                g.sense,
+                g.law.force,
+            )
+            for g in self.gears
+            if g.kind == "rolling-elements"
+        ]
         lin = []  # (lateral offset, k, C)
         hz = []  # (offset x | None, offset y | None, kb, c, ex, Cb, mode)
         bm = dict(zip([id(g) for g in self.hertz], bmodes, strict=True))
         for g in self.gears:
             if g.kind == "linear":
                 lin += [(i - n_tor, g.k[a], g.C[a]) for a, i in g.idx.items()]
-            else:
+            elif g.kind == "hertzian":
                 ox = g.idx[0] - n_tor if 0 in g.idx else None
                 oy = g.idx[1] - n_tor if 1 in g.idx else None
                 hz.append((ox, oy, g.kb, g.c, g.ex, g.Cb, bm[id(g)]))
@@ -284,6 +301,16 @@ class _LatTrain:
             acc.append((S[-1] - Mr) / Im)
             for j, kk, cc in lin:
                 fl[j] -= kk * ql[j] + cc * vl[j]
+            for ox, oy, it, sense, law in rolling:
+                x, yy = (
+                    (ql[ox], vl[ox]) if ox is not None else (0.0, 0.0),
+                    (ql[oy], vl[oy]) if oy is not None else (0.0, 0.0),
+                )
+                fx, fy = law(x[0], yy[0], x[1], yy[1], q[it] * sense)
+                if ox is not None:
+                    fl[ox] += fx
+                if oy is not None:
+                    fl[oy] += fy
             for ox, oy, kb, c, ex, Cb, bmode in hz:
                 if bmode != 1:
                     continue
@@ -359,6 +386,13 @@ class _LatTrain:
         for g in self.gears:
             if g.kind == "linear":
                 kk = max(g.k[a] for a in g.axes)
+            elif g.kind == "rolling-elements":  # tangent along the rated force's line, by differences
+                Fr = float(self.Frated[g.stage])
+                u0 = g.law.static_displacement(np.array([0.0, Fr]), (0, 1))
+                h = 1e-3 * float(np.hypot(*u0))
+                kk = abs(
+                    g.law.force(u0[0], u0[1] + h, 0, 0, 0)[1] - g.law.force(u0[0], u0[1] - h, 0, 0, 0)[1]
+                ) / (2 * h)
             else:
                 Fr = float(self.Frated[g.stage])
                 kk = g.ex * g.kb ** (1.0 / g.ex) * Fr ** (1.0 - 1.0 / g.ex)  # tangent stiffness at F_rated
@@ -401,6 +435,8 @@ class _LatTrain:
                 V[a] = ys[nd + i]
             if g.kind == "linear":
                 f = -(np.array(g.k)[:, None] * U + np.array(g.C)[:, None] * V)
+            elif g.kind == "rolling-elements":
+                f = g.law.forces(U, V, g.sense * ys[g.turn])
             elif bm[id(g)] == 1:
                 _, f_r = g.radial(ys, nd)
                 r = np.sqrt(U[0] ** 2 + U[1] ** 2)

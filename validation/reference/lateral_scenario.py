@@ -35,7 +35,7 @@ def _fill_gear(g: dict) -> None:
         if "bearing" not in g:
             raise ValueError("a lateral gear needs a bearing table")
         kind = g["bearing"]["kind"]
-        if kind not in ("linear", "hertzian"):
+        if kind not in ("linear", "hertzian", "rolling-elements"):
             raise ValueError(f"unknown bearing kind {kind!r}")
 
 
@@ -154,6 +154,10 @@ def static_displacement(bearing: dict, f, axes) -> np.ndarray:
     f[~mask] = 0.0
     par = bearing["parameters"]
     u0 = np.zeros(2)
+    if bearing["kind"] == "rolling-elements":
+        from .rolling_bearing import RollingBearing
+
+        return RollingBearing(bearing).static_displacement(f, axes)
     if bearing["kind"] == "linear":
         kk = [float(par["stiffness_x_N_per_m"]), float(par["stiffness_y_N_per_m"])]
         for a in axes:
