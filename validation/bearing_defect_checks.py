@@ -5,10 +5,11 @@ tests in tests/test_bearing_defect_theory.py assert them):
 
 lateral-8dof-ball on ball-by-ball bearings (:data:`validation.compare.BEARING_DEFECT`'s parameters),
 steady at rated load for 1 s, a 20 um defect in the pinion's bearing (SKF 6308 geometry: 8 balls,
-d/D = 0.232), seen by a housing accelerometer with one mode (5 kHz, 2 % damping) on the pinion's bearing
-forces and 0.3 m/s^2 of seeded noise (it buries the impacts where the mode does not amplify them); the
-first 0.1 s left out. Each row: the line theory predicts from the run's mean pinion speed, the largest bin of the squared-envelope spectrum (in the kurtogram's band) within the slip
-band round it, its distance and its height over the spectrum's median.
+d/D = 0.232), seen by a housing accelerometer with one mode (5 kHz, 2 % damping) on the pinion's
+bearing forces and 0.3 m/s^2 of seeded noise (it buries the impacts where the mode does not amplify
+them); the first 0.1 s left out. Each row: the line theory predicts from the run's mean pinion speed,
+the largest bin of the squared-envelope spectrum (in the kurtogram's band) within the slip band round
+it, its distance and its height over the spectrum's median.
 """
 
 from __future__ import annotations
