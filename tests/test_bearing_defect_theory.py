@@ -11,11 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from gearbody.analysis.kurtogram import fast_kurtogram
-from gearbody.diagnosis import DriveKinematics, analyze_recording
-from gearbody.model import load_scenario
-from validation.bearing_defect_checks import (
+from gearbody_validation.bearing_defect_checks import (
     SETTLE_S,
     SLIP,
     ZETA,
@@ -27,6 +23,10 @@ from validation.bearing_defect_checks import (
     run,
     within_slip,
 )
+
+from gearbody.analysis.kurtogram import fast_kurtogram
+from gearbody.diagnosis import DriveKinematics, analyze_recording
+from gearbody.model import load_scenario
 
 pytestmark = pytest.mark.slow
 

@@ -8,11 +8,11 @@ import math
 
 import numpy as np
 import pytest
+from gearbody_validation.reference.rolling_bearing import RollingBearing
 
 from gearbody.errors import ScenarioError
 from gearbody.model import load_scenario, scenario_to_dict
 from gearbody.physics.bearings import BearingDefect, RollingElementBearing, law_force_xy
-from validation.reference.rolling_bearing import RollingBearing
 
 GEOMETRY = {"balls": 8, "ball_diameter_m": 0.0079375, "pitch_diameter_m": 0.0335026}  # PHM 2009
 K = 8.0e9

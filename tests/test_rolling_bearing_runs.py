@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from gearbody_validation.compare import BEARING_DEFECT
 
 from gearbody.engine import compiled_path
 from gearbody.engine.simulate import simulate
 from gearbody.model import load_scenario, scenario_to_dict
-from validation.compare import BEARING_DEFECT
 
 WORKS, WHY = compiled_path.compiled_path_status()
 

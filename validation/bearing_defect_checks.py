@@ -1,7 +1,7 @@
 """Issue 30's checks of simulated bearing defects against theory, measured and printed as one table (the
 tests in tests/test_bearing_defect_theory.py assert them):
 
-    python -m validation.bearing_defect_checks
+    python -m gearbody_validation.bearing_defect_checks
 
 lateral-8dof-ball on ball-by-ball bearings (:data:`validation.compare.BEARING_DEFECT`'s parameters),
 steady at rated load for 1 s, a 20 um defect in the pinion's bearing (SKF 6308 geometry: 8 balls,
