@@ -88,6 +88,30 @@ def test_damaged_tooth_shows_red(tmp_path):
     assert red_pixels(sc) > 20 and red_pixels(load_scenario("one-stage")) == 0
 
 
+def test_a_gear_exudyn_cannot_outline_is_drawn_from_gearbodys_outline_with_its_damaged_tooth():
+    """Exudyn's involute generator leaves no root between 96 teeth at 20 deg (the idler gear of
+    scenes/phm2009.toml); such a gear takes gearbody's outline, its marked teeth drawn as on the others."""
+    import exudyn.machines as machines
+
+    from gearbody.render.layout import DAMAGED, GearShape
+    from gearbody.render.scene3d import _gear_graphics
+
+    m = 0.0254 / 16
+    with pytest.raises(ValueError):
+        machines.InvoluteGear(module=m, nTeeth=96, pressureAngleDeg=20.0).GenerateGear()
+    for teeth in (32, 96):  # Exudyn's outline, gearbody's
+        gear = GearShape(teeth, m, 20.0, 0.0127, 0.0, 0.008, 0.0, (0.6, 0.6, 0.5, 1.0), ((0.1, DAMAGED),))
+        assert len(_gear_graphics(gear)) == 2, teeth  # the gear and its damaged tooth
+    sc = load_scenario(
+        "phm2009", ['design.stages.1.damaged_teeth=[{gear="wheel",tooth=0,stiffness_factor=0.8}]']
+    )
+    vs = VisualSystem(build_layout(sc), RenderOptions(width_px=W, height_px=H, view="front", frame="gears"))
+    vs.set_camera()
+    vs.set_pose(np.zeros(3 * len(build_layout(sc).bodies)))
+    img = vs.image().astype(int)
+    assert ((img[..., 0] > 150) & (img[..., 1] < 80) & (img[..., 2] < 80)).sum() > 5
+
+
 def test_cli_render_writes_frames_and_gif_without_display(tmp_path, monkeypatch):
     monkeypatch.delenv("DISPLAY", raising=False)
     out = tmp_path / "pics"

@@ -120,12 +120,20 @@ def _gear_graphics(gear: GearShape):
     import exudyn.graphics as gr
     import exudyn.machines as machines
 
+    from .planetary import tooth_outline
+
     if gear.outline == "gearbody":
         return _outline_gear_graphics(gear)
 
     geometry = machines.InvoluteGear(
         module=gear.module_m, nTeeth=gear.teeth, pressureAngleDeg=gear.pressure_angle_deg
     )
+    try:
+        points = np.asarray(geometry.GenerateGear())  # tooth 0 centred on +x
+    except ValueError:  # Exudyn's generator leaves no root between many teeth (96 at 20 deg): gearbody's
+        m, r = gear.module_m, gear.pitch_radius_m
+        points = tooth_outline(gear.teeth, m, gear.pressure_angle_deg, r + m, r - 1.25 * m)
+        return [*_outline_gear_graphics(gear), *_tooth_marks(gear, points)]
     rot = _rot_z(gear.first_tooth_rad)
     out = [
         gr.InvoluteGear(
@@ -138,32 +146,41 @@ def _gear_graphics(gear: GearShape):
             nTilesCylinder=24,
         )
     ]
-    if gear.marked_teeth:
-        points = np.asarray(geometry.GenerateGear())  # tooth 0 centred on +x
-        half = math.pi / gear.teeth
-        ang = np.arctan2(points[:, 1], points[:, 0])
-        sel = points[np.abs(ang) < half]
-        sel = sel[np.argsort(np.arctan2(sel[:, 1], sel[:, 0]))] * 1.004  # stands 0.4 % proud of the gear
-        r_in = 0.97 * gear.root_radius_m  # the tooth only: its root edge hides in the rim
-        inner = [
-            [r_in * math.cos(half), r_in * math.sin(half)],
-            [r_in * math.cos(-half), r_in * math.sin(-half)],
-        ]
-        poly = np.vstack([sel, inner])
-        n = len(poly)
-        segments = [[i, (i + 1) % n] for i in range(n)]
-        for angle, colour in gear.marked_teeth:
-            width = 1.02 * gear.face_width_m
-            out.append(
-                gr.SolidExtrusion(
-                    poly.tolist(),
-                    segments,
-                    width,
-                    rot=_rot_z(angle),
-                    pOff=[0, 0, gear.z_m - width / 2],
-                    color=list(colour),
-                )
+    return [*out, *_tooth_marks(gear, points)]
+
+
+def _tooth_marks(gear: GearShape, points: np.ndarray) -> list:
+    """The gear's marked (damaged, pitted) teeth in their colours, cut from its outline ``points`` (n, 2)
+    with tooth 0 centred on +x."""
+    import exudyn.graphics as gr
+
+    if not gear.marked_teeth:
+        return []
+    half = math.pi / gear.teeth
+    ang = np.arctan2(points[:, 1], points[:, 0])
+    sel = points[np.abs(ang) < half]
+    sel = sel[np.argsort(np.arctan2(sel[:, 1], sel[:, 0]))] * 1.004  # stands 0.4 % proud of the gear
+    r_in = 0.97 * gear.root_radius_m  # the tooth only: its root edge hides in the rim
+    inner = [
+        [r_in * math.cos(half), r_in * math.sin(half)],
+        [r_in * math.cos(-half), r_in * math.sin(-half)],
+    ]
+    poly = np.vstack([sel, inner])
+    n = len(poly)
+    segments = [[i, (i + 1) % n] for i in range(n)]
+    out = []
+    for angle, colour in gear.marked_teeth:
+        width = 1.02 * gear.face_width_m
+        out.append(
+            gr.SolidExtrusion(
+                poly.tolist(),
+                segments,
+                width,
+                rot=_rot_z(angle),
+                pOff=[0, 0, gear.z_m - width / 2],
+                color=list(colour),
             )
+        )
     return out
 
 
