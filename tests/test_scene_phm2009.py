@@ -62,7 +62,7 @@ def test_every_gear_sits_on_the_published_er10k_geometry(scenario):
         assert g.pitch_diameter_m == pytest.approx(PITCH_D_M, rel=1e-6)
     for st in scenario.stages:
         for gear in (st.pinion, st.wheel):
-            assert gear.lateral == "xy" and gear.bearing.kind == "hertzian"
+            assert gear.lateral == "xy" and gear.bearing.kind == "rolling-elements"
 
 
 def test_the_run_is_sampled_at_the_data_rate(scenario):
