@@ -37,7 +37,9 @@ def register(sub) -> argparse.ArgumentParser:
             "stage K_d over time and folded over the mesh period (stage k > 1: kd_time_stage_k.png, "
             "...), the spectrum of the pinion acceleration (lateral: housing acceleration) when the "
             "first stage is parallel, per planetary stage the planets' K_d, the load sharing and the "
-            "ring-sensor spectrum. DIR must be empty, hold a run of the same resolved scenario (it is "
+            "ring-sensor spectrum. A scenario with an [instruments] table also gets DIR/instruments.mat: "
+            "its virtual accelerometers and tacho as a recording ('gearbody analyze DIR' analyses it; "
+            "docs/recordings.md). DIR must be empty, hold a run of the same resolved scenario (it is "
             "written again) or be replaced with --overwrite; DIR/.gearbody.json records the run."
         ),
     )
@@ -65,6 +67,9 @@ def register(sub) -> argparse.ArgumentParser:
     run.set_defaults(handler=execute)
     return run
 
+
+INSTRUMENTS_FILE = "instruments.mat"
+"""The run's virtual recording (MATLAB v5: scipy writes it, every tool reads it; bit-exact for gearbody)."""
 
 PLANETARY_SHOWN = (
     "kd_max",
@@ -107,6 +112,10 @@ def execute(args) -> int:
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
     if not args.no_plots or args.report:
         check_plottable(scenario, args)
+    if scenario.instruments is not None:  # force signals, tacho shaft, FRF files: before the run
+        from gearbody.recording.virtual import check_instruments
+
+        check_instruments(scenario)
     check_wall_time(scenario, args)
     identity = {"scenario": scenario_to_dict(scenario)}  # what makes a run the same run
     with claim(out, "run", identity, overwrite=args.overwrite) as folder:  # locked while it writes
@@ -124,6 +133,11 @@ def execute(args) -> int:
             from gearbody.reports.html import write_report
 
             write_report(result, out / "report.html")
+        if scenario.instruments is not None:
+            from gearbody.recording.files import write_recording
+            from gearbody.recording.virtual import virtual_recording
+
+            write_recording(virtual_recording(result, scenario), out / INSTRUMENTS_FILE)
         folder.finish()
     if not args.quiet:
         print(f"{scenario.meta.title}")
@@ -152,5 +166,6 @@ def execute(args) -> int:
             f"wrote {out}/result.npz, scenario.toml, summary.json"
             + (f", {len(plots)} plots" if plots else "")
             + (", report.html" if args.report else "")
+            + (f", {INSTRUMENTS_FILE}" if scenario.instruments is not None else "")
         )
     return EXIT_OK

@@ -5,12 +5,13 @@ a logger's), and the checks that need the drive's kinematics or a file, made bef
 
 A sensor path names force signals of the run. Before the run they are checked against
 :func:`force_signal_names`, the names the run will give (the signal contract of
-:mod:`gearbody.signals`): every lateral gear's and every planetary member's bearing forces
-``<body>_bearing_force_<x|y>_N`` and each parallel stage's mesh force (``mesh_force_N``,
-``stage_2_mesh_force_N``; with ``solver.anti_aliasing`` their band-limited companions
-``..._mesh_force_bandlimited_N``). A stage of a kind registered by a plugin (docs/extending.md) names
-signals gearbody cannot foresee: its names are checked only after the run, when the recording is made,
-against the force signals the run gave.
+:mod:`gearbody.signals`): the bearing forces on the housing ``<body>_bearing_force_<x|y>_N`` of every
+lateral gear and of every planetary stage's sun, ring and carrier (a planet's bearing sits on the
+carrier), each parallel stage's mesh force (``mesh_force_N``, ``stage_2_mesh_force_N``; with
+``solver.anti_aliasing`` their band-limited companions ``..._mesh_force_bandlimited_N``) and each
+planetary stage's ring sensor (``ring_sensor_N``). A stage of a kind registered by a plugin
+(docs/extending.md) names signals gearbody cannot foresee: its names are checked only after the run,
+when the recording is made, against the force signals the run gave.
 """
 
 from __future__ import annotations
@@ -37,10 +38,10 @@ def force_signal_names(scenario) -> list[str] | None:
             bodies = [
                 b for b, g in zip(gear_names(k), (st.pinion, st.wheel), strict=True) if g.lateral != "none"
             ]
-        elif kind == "planetary":
+        elif kind == "planetary":  # the members in the housing (a planet's bearing is on the carrier)
             p = stage_prefix(k)
+            names.append(p + "ring_sensor_N")
             bodies = [p + m for m in ("sun", "ring", "carrier")]
-            bodies += [f"{p}planet_{n + 1}" for n in range(st.planets)]
         else:
             return None
         names += [f"{b}_bearing_force_{axis}_N" for b in bodies for axis in "xy"]
@@ -129,9 +130,6 @@ def virtual_recording(result, scenario=None) -> Recording:
         )
     except GearbodyError as exc:
         raise type(exc)(f"writing the virtual instruments after the run: {exc}") from None
-    rec.meta.update(
-        scenario=scenario_to_dict(scenario),
-        title=str(scenario.meta.title or scenario.name),
-        vibration_channel=inst.accelerometers[0].name,
-    )
+    # every accelerometer is analysed, as a logger's channels are (no "vibration_channel": a run's one)
+    rec.meta.update(scenario=scenario_to_dict(scenario), title=str(scenario.meta.title or scenario.name))
     return rec
