@@ -103,6 +103,15 @@ def check_plottable(scenario, args) -> None:
     )
 
 
+def bearing_marks(result) -> list:
+    """The bearing defect frequencies (BPFO, BPFI, 2 BSF, FTF of every bearing with geometry) at the run's
+    mean input speed over its final window, for its spectrum plot (none when the run has no scenario)."""
+    from gearbody.reports.bearings import run_bearing_section
+
+    section, input_hz = run_bearing_section(result)
+    return section.marks(input_hz, float("inf"))
+
+
 def execute(args) -> int:
     out = check_out(args.out or default_out(args.scene))  # before anything is imported or run
     from gearbody.engine import simulate
@@ -128,7 +137,7 @@ def execute(args) -> int:
         summary["wall_time_s"] = time.perf_counter() - t0
         write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
         warn_if_backwards(result)
-        plots = [] if args.no_plots else result.plot(out)
+        plots = [] if args.no_plots else result.plot(out, marks=bearing_marks(result))
         if args.report:
             from gearbody.reports.html import write_report
 
