@@ -17,7 +17,7 @@ from gearbody.plotting.report import labelled_spectrum_figure
 from gearbody.plotting.result import spectrum_figure
 from gearbody.plotting.spectrum import LINE_COLOURS, mark_lines, zoom_limit
 from gearbody.reports.bearings import bearing_section, run_bearing_section
-from gearbody.reports.html import report_sections, write_report
+from gearbody.reports.html import bearing_html, report_sections, write_report
 
 GEOMETRY = "{balls=12,ball_diameter_m=0.012,pitch_diameter_m=0.08}"
 
@@ -67,7 +67,7 @@ def test_the_table_holds_every_line_of_every_bearing_from_the_one_formula():
 def test_a_scene_without_geometry_says_so(scene, note):
     section = bearing_section(DriveKinematics.from_scenario(gb.load_scenario(scene)), {})
     assert not section.rows and section.notes[0].startswith(note)
-    assert note in section.html().replace("&#x27;", "'")
+    assert note in bearing_html(section).replace("&#x27;", "'")
 
 
 def test_the_run_report_has_the_table_and_marks_the_lines_on_its_spectrum(tmp_path):

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 import gearbody as gb
+from gearbody.diagnosis.virtual import check_instruments, force_signal_names
 from gearbody.model import dump_scenario, load_scenario, scenario_to_dict
 from gearbody.model.scenes import list_scenes, scene_path
 from gearbody.recording.frf import MeasuredFRF, write_frf
 from gearbody.recording.instruments import HousingMode
-from gearbody.recording.virtual import check_instruments, force_signal_names
 
 TABLE = """
 [instruments]

@@ -122,7 +122,7 @@ def execute(args) -> int:
     if not args.no_plots or args.report:
         check_plottable(scenario, args)
     if scenario.instruments is not None:  # force signals, tacho shaft, FRF files: before the run
-        from gearbody.recording.virtual import check_instruments
+        from gearbody.diagnosis.virtual import check_instruments
 
         check_instruments(scenario)
     check_wall_time(scenario, args)
@@ -143,8 +143,8 @@ def execute(args) -> int:
 
             write_report(result, out / "report.html")
         if scenario.instruments is not None:
+            from gearbody.diagnosis.virtual import virtual_recording
             from gearbody.recording.files import write_recording
-            from gearbody.recording.virtual import virtual_recording
 
             write_recording(virtual_recording(result, scenario), out / INSTRUMENTS_FILE)
         folder.finish()

@@ -1,12 +1,12 @@
 """The ``[instruments]`` table of a scenario: virtual housing accelerometers (their path from the run's
 force signals: housing modes or a measured FRF file; noise, sensitivity, where they sit), one data
 acquisition rate, a tacho and a seed. What a run records with them is evaluated after the solve
-(:mod:`gearbody.recording.virtual`); the solve never reads this table.
+(:mod:`gearbody.diagnosis.virtual`); the solve never reads this table.
 
 Checked here, when the scenario is built: every key's type and range, names, one path per sensor, the
 acquisition rate against the run's output rate, every mode below the run's Nyquist frequency. What needs
 the drive's kinematics or a file (the force-signal names, the tacho's shaft, the FRF file's content) is
-checked before a run starts, by :func:`gearbody.recording.virtual.check_instruments`.
+checked before a run starts, by :func:`gearbody.diagnosis.virtual.check_instruments`.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ MAX_DENOMINATOR = 1000
 class SensorMode(Node):
     """A housing mode between bearing forces and a sensor (gearbody.recording.instruments.HousingMode)."""
 
-    frequency_hz: float = param(gt=0, doc="natural frequency f_n [Hz] (< the run's Nyquist frequency)")
+    frequency_hz: float = param(gt=0, doc="natural frequency f_n (< the run's Nyquist frequency)")
     damping_ratio: float = param(ge=1e-4, lt=1, doc="modal damping ratio zeta")
     participation: dict[str, float] = param(
         doc="force signal -> accelerance above the mode phi [(m/s^2)/N] (= 1 / effective mass)"
@@ -103,7 +103,7 @@ class Instruments(Node):
     accelerometers: tuple[AccelerometerSpec, ...] = param(doc="the housing accelerometers (at least one)")
     tacho: TachoSpec = param(default_factory=TachoSpec, doc="the tacho")
     sample_rate_hz: float | None = param(
-        None, gt=0, doc="acquisition rate of every channel [Hz] (unset: solver.output_rate_hz)"
+        None, gt=0, doc="acquisition rate of every channel (unset: solver.output_rate_hz)"
     )
     seed: int | None = param(None, ge=0, le=2**63 - 1, doc="seed of the sensors' noise (unset: meta.seed)")
 

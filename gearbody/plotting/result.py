@@ -191,9 +191,7 @@ def spectrum_figure(
         )
 
     if low is not None:  # the shaft frequencies, and bearing lines up to 10 shaft orders
-        f_low = min(fmax, SHAFT_PANEL_ORDERS * shown_shafts[-1][1])
-        crowded = [float(m.frequency_hz) for m in marks if 0 < m.frequency_hz <= 10 * shown_shafts[-1][1]]
-        f_low = min(fmax, max(f_low, 1.1 * max(crowded, default=0.0)))
+        f_low = _low_panel_top(fmax, shown_shafts[-1][1], marks)
         inside = freq <= f_low
         _spectrum_axes(low, freq[inside], amp[inside], log_amplitude, (0.0, f_low), ylabel)
         resolution = f", bins of {freq[1] - freq[0]:.3g} Hz" if freq.size > 1 else ""
@@ -209,13 +207,24 @@ def spectrum_figure(
     fig.draw_without_rendering()  # the final layout: labels inside the axes are measured in it
     for axes, labels, colour in labelled:
         _marker_labels(axes, labels, colour)
-    if marks:
-        from .spectrum import mark_lines
+    _mark(ax, low, marks, fmax)
+    return fig
 
+
+def _low_panel_top(fmax: float, fastest_shaft_hz: float, marks: Sequence) -> float:
+    """The low panel's top: SHAFT_PANEL_ORDERS shaft orders, widened to the marks up to 10 of them."""
+    crowded = [float(m.frequency_hz) for m in marks if 0 < m.frequency_hz <= 10 * fastest_shaft_hz]
+    return min(fmax, max(SHAFT_PANEL_ORDERS * fastest_shaft_hz, 1.1 * max(crowded, default=0.0)))
+
+
+def _mark(ax, low, marks: Sequence, fmax: float) -> None:
+    """``marks`` on the spectrum: labelled in the low panel when there is one, else in ``ax``."""
+    from .spectrum import mark_lines
+
+    if marks:
         mark_lines(ax, marks, fmax, labels=low is None)
         if low is not None:
             mark_lines(low, marks, low.get_xlim()[1])
-    return fig
 
 
 def _spectrum_axes(ax, freq, amp, log_amplitude: bool, xlim: tuple[float, float], ylabel: str) -> None:

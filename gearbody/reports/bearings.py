@@ -7,7 +7,6 @@ and as orders of the bearing's own shaft and of the input shaft), the lines to m
 
 from __future__ import annotations
 
-import html
 from collections.abc import Mapping
 from typing import Any
 
@@ -33,7 +32,8 @@ NOTE = (
 
 class BearingSection:
     """What a report shows of the drive's bearings: ``rows`` (one per bearing and line), ``columns``
-    (key -> header), ``notes`` and ``marks(input_hz, f_max)``, the lines to draw on a spectrum."""
+    (key -> header), ``notes`` and ``marks(input_hz, f_max)``, the lines to draw on a spectrum
+    (:func:`gearbody.reports.html.bearing_html` writes it on a page)."""
 
     def __init__(self, drive, speeds: Mapping[str, float]):
         self.drive = drive
@@ -81,16 +81,6 @@ class BearingSection:
         if self.drive is None or not np.isfinite(input_hz) or input_hz <= 0:
             return []
         return self.drive.bearing_lines(input_hz, f_max, harmonics=1)
-
-    def html(self) -> str:
-        """The section of a report page: heading, notes and the table."""
-        from .html import _table
-
-        parts = ["<h2>Bearing fault frequencies</h2>"]
-        parts += [f"<p>{html.escape(n)}</p>" for n in self.notes]
-        if self.rows:
-            parts.append(_table(self.rows, list(self.columns), self.columns))
-        return "\n".join(parts)
 
 
 def bearing_section(drive, speeds: Mapping[str, float]) -> BearingSection:

@@ -19,7 +19,7 @@ from gearbody.plotting.figure import png_bytes
 from gearbody.plotting.recording import overlay_figure
 
 from .bearings import bearing_section
-from .html import _table
+from .html import _table, bearing_html
 from .recording import STYLE
 
 __all__ = ["write_comparison"]
@@ -84,7 +84,7 @@ def write_comparison(comparison, out: str | Path, title: str) -> list[Path]:
         f"<code>{html.escape(comparison.run.drive.scene)}</code>.</p>",
         "<h2>Order spectra</h2>",
         f'<img src="data:image/png;base64,{image}" alt="overlay">' if image else "<p>no order spectrum</p>",
-        bearings.html(),
+        bearing_html(bearings),
         "<h2>Features (ratio = recording / run)</h2>",
         _table(comparison.rows),
         "</body></html>",

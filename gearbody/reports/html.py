@@ -28,7 +28,7 @@ from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure,
 from gearbody.result import Result
 from gearbody.signals import signal_unit
 
-__all__ = ["PEAK_COLUMNS", "report_sections", "spectrum_lines", "write_report"]
+__all__ = ["PEAK_COLUMNS", "bearing_html", "report_sections", "spectrum_lines", "write_report"]
 
 MIN_TSA_REVOLUTIONS = 2
 
@@ -71,6 +71,15 @@ def _table(
         "<tr>" + "".join(f"<td>{cell(r.get(c, ''))}</td>" for c in columns) + "</tr>" for r in rows
     )
     return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def bearing_html(section) -> str:
+    """A page's section of the bearings' fault frequencies (a
+    :class:`~gearbody.reports.bearings.BearingSection`): heading, notes and the table."""
+    parts = ["<h2>Bearing fault frequencies</h2>", *(f"<p>{html.escape(n)}</p>" for n in section.notes)]
+    if section.rows:
+        parts.append(_table(section.rows, list(section.columns), section.columns))
+    return "\n".join(parts)
 
 
 def report_sections(result: Result) -> dict[str, Any]:
@@ -165,7 +174,7 @@ def write_report(result: Result, path: str | Path) -> Path:
         _table(
             s["peaks"], list(PEAK_COLUMNS), {k: v.format(unit=s["unit"]) for k, v in PEAK_COLUMNS.items()}
         ),
-        s["bearings"].html(),
+        bearing_html(s["bearings"]),
         "<h2>Synchronous average and condition indicators</h2>",
         img.get("tsa", f"<p>{html.escape(s.get('tsa_note', ''))}</p>"),
         _table([{"indicator": k, "value": v} for k, v in s["indicators"].items()]),

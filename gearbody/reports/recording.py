@@ -25,7 +25,7 @@ from gearbody.plotting.recording import (
 )
 from gearbody.plotting.report import labelled_spectrum_figure
 
-from .html import PEAK_COLUMNS, _table
+from .html import PEAK_COLUMNS, _table, bearing_html
 
 __all__ = ["diagnosis_figures", "write_diagnosis"]
 
@@ -142,7 +142,7 @@ def _page(diag, images: dict[str, str], title: str) -> str:
         f"({html.escape(diag.angles.source)}); mean input shaft speed {diag.mean_input_hz:.4f} rev/s "
         f"({60 * diag.mean_input_hz:.1f} rpm).</p>",
         *(f"<p><b>note:</b> {html.escape(n)}</p>" for n in diag.notes),
-        _bearings(diag).html(),
+        bearing_html(_bearings(diag)),
     ]
     for name, ch in diag.channels.items():
         tag = _slug(name)

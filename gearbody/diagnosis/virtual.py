@@ -1,7 +1,9 @@
 """A scenario's ``[instruments]`` on a run: what its virtual accelerometers and tacho record
 (:func:`virtual_recording`, a :class:`~gearbody.recording.Recording` that ``gearbody analyze`` reads like
 a logger's), and the checks that need the drive's kinematics or a file, made before a run starts
-(:func:`check_instruments`).
+(:func:`check_instruments`). The instruments themselves (the sensor path, noise, rate, tacho) are
+:mod:`gearbody.recording.instruments` and :mod:`gearbody.recording.frf`; this module reads them off the
+scenario, with the drive's kinematics (:class:`DriveKinematics`) for the tacho's shaft.
 
 A sensor path names force signals of the run. Before the run they are checked against
 :func:`force_signal_names`, the names the run will give (the signal contract of
@@ -17,8 +19,9 @@ when the recording is made, against the force signals the run gave.
 from __future__ import annotations
 
 from ..errors import GearbodyError, InputError, ScenarioError
+from ..recording.container import Recording
 from ..signals import gear_names, stage_prefix
-from .container import Recording
+from .drive import DriveKinematics
 
 __all__ = ["check_instruments", "force_signal_names", "virtual_recording"]
 
@@ -53,8 +56,7 @@ def check_instruments(scenario) -> dict[int, object]:
     force signal the run will not give (listing those it will), a tacho shaft that is not a rotating body
     of the drive, or an FRF file that cannot be read or used at ``solver.output_rate_hz``
     (:mod:`gearbody.recording.frf`). Returns the FRFs read, by accelerometer number (from 1)."""
-    from ..diagnosis import DriveKinematics
-    from .frf import read_frf
+    from ..recording.frf import read_frf
 
     inst = scenario.instruments
     if inst is None:
@@ -95,9 +97,8 @@ def virtual_recording(result, scenario=None) -> Recording:
     pulse times, the scenario in ``meta["scenario"]`` (docs/recordings.md, "Virtual instruments").
     :func:`check_instruments` runs first; a force signal the run lacks is a SignalError naming those it
     has."""
-    from ..diagnosis import DriveKinematics
     from ..model import load_scenario, scenario_to_dict
-    from .instruments import Accelerometer, HousingMode, virtual_instruments
+    from ..recording.instruments import Accelerometer, HousingMode, virtual_instruments
 
     if scenario is None:
         if not isinstance(result.meta.get("scenario"), dict):
