@@ -167,3 +167,16 @@ def test_a_torsional_scene_offers_its_mesh_force_only():
     assert force_signal_names(sc) == ["mesh_force_N", "mesh_force_bandlimited_N"]
     with pytest.raises(gb.ScenarioError, match="its force signals: mesh_force_N, mesh_force_bandlimited_N$"):
         check_instruments(load_scenario("one-stage", [ONE]))
+
+
+def test_gearbody_new_writes_the_table_with_every_key_commented_and_it_loads_back(tmp_path, capsys):
+    from gearbody.cli import main
+
+    path = _scene(tmp_path)
+    assert main(["new", str(path), "--out", str(tmp_path / "new.toml")]) == 0
+    text = (tmp_path / "new.toml").read_text()
+    assert "[[instruments.accelerometers]]" in text and "# noise_rms_m_s2: not set;" in text
+    assert load_scenario(tmp_path / "new.toml").instruments == load_scenario(path).instruments
+    assert main(["new", "one-stage", "--out", str(tmp_path / "plain.toml")]) == 0
+    assert "# [instruments]: not set;" in (tmp_path / "plain.toml").read_text()
+    capsys.readouterr()
