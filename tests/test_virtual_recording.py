@@ -101,6 +101,7 @@ def test_analyze_a_run_folder_reads_its_virtual_instruments(run_folder, tmp_path
     [
         (["--tacho-shaft", "pinion"], "--tacho-shaft: the run's virtual instruments"),
         (["--unit", "acc_pinion=g"], "--unit: the run's virtual instruments"),
+        (["--pulses-per-rev", "0"], "--pulses-per-rev: the run's virtual instruments"),
     ],
 )
 def test_options_for_a_loggers_file_are_refused_on_the_virtual_recording(
@@ -151,3 +152,23 @@ def test_a_result_without_scenario_or_table_is_refused():
         gb.virtual_recording(result)
     with pytest.raises(gb.InputError, match="has no \\[instruments\\] table"):
         gb.virtual_recording(result, gb.load_scenario("one-stage"))
+
+
+def test_a_run_too_short_for_the_tacho_is_recorded_tacholess_and_says_so(scene, tmp_path, capsys):
+    out = tmp_path / "r"
+    assert main(["run", str(scene), "--t-end", "0.004", "--no-plots", "--quiet", "--out", str(out)]) == 0
+    err = capsys.readouterr().err  # 4 ms of a wheel at 5.6 rev/s, 2 pulses per revolution: one pulse
+    assert "the tacho on wheel gave 1 pulses in the run (a tacho needs 3): the recording has no tacho" in err
+    rec = gb.read_recording(out / "instruments.mat")
+    assert rec.tacho is None and rec.n_samples == 41 and "tacho_note" in rec.meta
+
+
+def test_an_acquisition_of_fewer_than_two_samples_is_refused_before_the_run(scene, tmp_path, capsys):
+    out = tmp_path / "r"
+    argv = ["run", str(scene), "--t-end", "0.0002", "--set", "instruments.sample_rate_hz=100.0"]
+    assert main([*argv, "--no-plots", "--quiet", "--out", str(out)]) == 2
+    assert (
+        "instruments.sample_rate_hz = 100: 1 sample(s) over operation.t_end_s = 0.0002"
+        in capsys.readouterr().err
+    )
+    assert not out.exists()

@@ -222,7 +222,7 @@ def _instruments_recording(path: Path, args):
             ("--pulses-per-rev", args.pulses_per_rev),
             ("--tacho-shaft", args.tacho_shaft),
         )
-        if v
+        if v is not None and v != []
     ]
     if given:
         raise InputError(

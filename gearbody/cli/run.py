@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 
 from .common import (
@@ -146,7 +147,10 @@ def execute(args) -> int:
             from gearbody.diagnosis.virtual import virtual_recording
             from gearbody.recording.files import write_recording
 
-            write_recording(virtual_recording(result, scenario), out / INSTRUMENTS_FILE)
+            recording = virtual_recording(result, scenario)
+            write_recording(recording, out / INSTRUMENTS_FILE)
+            if recording.tacho is None:
+                print(f"gearbody: note: {recording.meta['tacho_note']}", file=sys.stderr)
         folder.finish()
     if not args.quiet:
         print(f"{scenario.meta.title}")

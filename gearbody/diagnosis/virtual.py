@@ -18,6 +18,8 @@ when the recording is made, against the force signals the run gave.
 
 from __future__ import annotations
 
+import math
+
 from ..errors import GearbodyError, InputError, ScenarioError
 from ..recording.container import Recording
 from ..signals import gear_names, stage_prefix
@@ -71,6 +73,17 @@ def check_instruments(scenario) -> dict[int, object]:
                     f"signals: {', '.join(valid)}"
                 )
 
+    from fractions import Fraction
+
+    from ..model.budget import output_samples
+
+    rate, out_rate = inst.sample_rate_hz or scenario.solver.output_rate_hz, scenario.solver.output_rate_hz
+    acquired = math.ceil(output_samples(scenario) * Fraction(rate / out_rate).limit_denominator(1000))
+    if acquired < 2:
+        raise ScenarioError(
+            f"instruments.sample_rate_hz = {rate:g}: {acquired} sample(s) over operation.t_end_s = "
+            f"{scenario.operation.t_end_s:g}; a recording needs at least 2"
+        )
     frfs: dict[int, object] = {}
     for k, acc in enumerate(inst.accelerometers, 1):
         key = f"instruments.accelerometers.{k}"

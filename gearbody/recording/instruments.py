@@ -39,7 +39,10 @@ from .frf import MeasuredFRF, convolve, modal_kernels, uniform_rate
 from .from_run import hermite_crossings
 from .tacho import Tacho
 
-__all__ = ["Accelerometer", "HousingMode", "housing_acceleration", "virtual_instruments"]
+__all__ = ["MIN_PULSES", "Accelerometer", "HousingMode", "housing_acceleration", "virtual_instruments"]
+
+MIN_PULSES = 3
+"""Fewest pulses a tacho holds (:class:`~gearbody.recording.tacho.Tacho`); fewer: no tacho."""
 
 
 @dataclass(frozen=True)
@@ -128,7 +131,8 @@ def virtual_instruments(
 ) -> Recording:
     """The run ``result`` seen by ``accelerometers`` and a tacho of ``pulses_per_rev`` pulses per
     revolution of ``tacho_shaft``, as a :class:`Recording` (every accelerometer at the rate of the first;
-    the same ``seed`` gives bit-identical noise)."""
+    the same ``seed`` gives bit-identical noise; without a tacho, and ``meta["tacho_note"]`` saying why,
+    when the run gives fewer than MIN_PULSES pulses)."""
     if not accelerometers:
         raise InputError("virtual_instruments: give at least one Accelerometer")
     t = np.asarray(result.time_s, dtype=float)
@@ -159,6 +163,12 @@ def virtual_instruments(
     pulses = hermite_crossings(t, angle, speed, 2 * math.pi / pulses_per_rev)
     meta = {"source": "virtual instruments", "scene": result.meta.get("scene"), "seed": seed,
             "scenario": result.meta.get("scenario")}  # fmt: skip
-    return Recording(
-        fs, channels, float(t[0]), Tacho(tacho_shaft, pulses_per_rev, pulse_times_s=pulses), meta
-    )
+    tacho = None
+    if pulses.size >= MIN_PULSES:
+        tacho = Tacho(tacho_shaft, pulses_per_rev, pulse_times_s=pulses)
+    else:  # a run too short for a tacho: the recording is tacholess, and says so
+        meta["tacho_note"] = (
+            f"the tacho on {tacho_shaft} gave {pulses.size} pulses in the run (a tacho needs "
+            f"{MIN_PULSES}): the recording has no tacho; run longer or give more pulses_per_rev"
+        )
+    return Recording(fs, channels, float(t[0]), tacho, meta)
