@@ -52,6 +52,7 @@ from .version import __version__
 if TYPE_CHECKING:  # what __getattr__ gives, for type checkers and editors
     from . import analysis, extend, render, studies
     from .diagnosis import DriveKinematics, analyze_recording
+    from .diagnosis.virtual import virtual_recording
     from .engine import scene_modes as modes
     from .engine import simulate
     from .recording.files import read_recording, write_recording
@@ -62,6 +63,7 @@ _LAZY = {
     "analysis": ("gearbody.analysis", None),
     "read_recording": ("gearbody.recording.files", "read_recording"),
     "write_recording": ("gearbody.recording.files", "write_recording"),
+    "virtual_recording": ("gearbody.diagnosis.virtual", "virtual_recording"),
     "analyze_recording": ("gearbody.diagnosis", "analyze_recording"),
     "DriveKinematics": ("gearbody.diagnosis", "DriveKinematics"),
     "studies": ("gearbody.studies", None),
@@ -95,6 +97,7 @@ __all__ = [
     "analyze_recording",
     "read_recording",
     "write_recording",
+    "virtual_recording",
     "CalibrationFailed",
     "FolderInUse",
     "GearbodyError",

@@ -117,7 +117,7 @@ KINDS: dict[str, Kind] = {  # studies first: their spec files mark them
     "run": Kind(
         "run",
         "a 'gearbody run' result",
-        ("result.npz", "scenario.toml", "summary.json", "report.html", *RUN_PLOTS),
+        ("result.npz", "scenario.toml", "summary.json", "report.html", "instruments.mat", *RUN_PLOTS),
         ("result.npz", "summary.json", "scenario.toml", "report.html", *RUN_PLOTS),
     ),
 }

@@ -113,8 +113,10 @@ RESULT_FILES = [
 """``render --result`` kinds."""
 RECORDING_FILES = [
     "rec-h5", "rec-wav", "rec-csv", "rec-csv-nan", "rec-csv-ragged", "rec-wav-empty", "run-folder", "run-npz",
+    "run-instruments",
 ]  # fmt: skip
-"""``analyze`` / ``compare`` RECORDING kinds (a logger's files, good and bad, and a run)."""
+"""``analyze`` / ``compare`` RECORDING kinds (a logger's files, good and bad, a run, and a run folder with
+its virtual instruments' instruments.mat)."""
 OUT_PATHS = [
     "fresh", "nested-fresh", "existing-file", "fifo", "symlink-loop", "broken-symlink", "dir-with-junk",
     "through-file", "long-name", "newline-name", "empty-name", "dot", "symlink-to-folder", "non-utf8-name",
@@ -268,7 +270,17 @@ def make_recording(kind: str, folder: Path) -> str:
         return "rec.csv"
     run = next(folder / f"run{k}" for k in range(100) if not (folder / f"run{k}").exists())
     shutil.copytree(_run_folder(), run)
-    return run.name if kind == "run-folder" else os.path.join(run.name, "result.npz")
+    if kind == "run-instruments":  # the run's mesh force seen by an accelerometer behind a 2 kHz mode
+        import gearbody as gb
+        from gearbody.model import scenario_to_dict
+
+        result = gb.Result.load_npz(run / "result.npz")
+        mode = {"frequency_hz": 2000.0, "damping_ratio": 0.05, "participation": {"mesh_force_N": 0.02}}
+        table = {"accelerometers": [{"name": "acc", "noise_rms_g": 0.01, "modes": [mode]}]}
+        scenario = gb.load_scenario({**result.meta["scenario"], "instruments": table})
+        result.meta["scenario"] = scenario_to_dict(scenario)
+        gb.write_recording(gb.virtual_recording(result), run / "instruments.mat")
+    return run.name if kind in ("run-folder", "run-instruments") else os.path.join(run.name, "result.npz")
 
 
 def make_out(kind: str, folder: Path) -> str:
@@ -479,7 +491,7 @@ def options(command: str) -> list[Option]:
                 ["1,1,1", "0,0,0", "2,0,0", "nan,0,0", "1,1", "1,1,1,1", "", "a,b,c"]
             ),
         },
-        "analyze": recording_options(),
+        "analyze": {**recording_options(), "--run-signals": st.none()},
         "compare": {**recording_options(), "--run-channel": st.sampled_from([*TEXTS, "pinion_accel_rad_s2"])},
     }[command]
     names = {**common, **own}

@@ -8,6 +8,7 @@ import argparse
 from pathlib import Path
 
 from .common import EXIT_OK, add_out, add_overwrite, add_set, check_out, number
+from .run import INSTRUMENTS_FILE
 
 __all__ = ["add_recording_options", "open_recording", "register"]
 
@@ -79,7 +80,10 @@ def register(sub) -> argparse.ArgumentParser:
             "shaft with FM0, FM4, NA4, M6A, M8A and the energy ratio; fault-band metrics; the kurtogram "
             "and the squared-envelope spectrum in its band. Every shaft's angle comes from one tacho "
             "through the scene's ratios (or, without a tacho, from the first mesh harmonic near "
-            "--input-speed, default the scene's nominal speed)."
+            "--input-speed, default the scene's nominal speed). A run folder that holds instruments.mat "
+            "(a scenario with an [instruments] table) is analysed through its virtual instruments, like a "
+            "logger's file: the accelerometers and the tacho the scenario describes, over the run's last "
+            "quarter; --run-signals analyses the run's own signals instead."
         ),
     )
     p.add_argument("recording", metavar="RECORDING", help="recording file, or a run's result.npz or folder")
@@ -91,6 +95,12 @@ def register(sub) -> argparse.ArgumentParser:
     )
     add_set(p, "override a value of --scene's scenario by its dotted key (repeatable)")
     add_recording_options(p)
+    p.add_argument(
+        "--run-signals",
+        action="store_true",
+        help="a run folder: analyse the run's own signals (result.npz), not its virtual instruments "
+        "(instruments.mat, analysed by default when the folder holds it)",
+    )
     p.add_argument("--no-envelope", action="store_true", help="skip the kurtogram and the envelope spectrum")
     p.add_argument(
         "--prewhiten",
@@ -124,8 +134,13 @@ def open_recording(args, path: str | None = None, need_scenario: bool = True):
         raise InputError(f"{label} {source}: cannot be used: {exc.strerror or exc}") from None
     if not found:
         raise InputError(f"{label} {source}: no such file or folder")
-    if folder or source.suffix == ".npz":
+    run_signals = getattr(args, "run_signals", False)
+    if folder and not run_signals and (source / INSTRUMENTS_FILE).is_file():
+        rec = _instruments_recording(source / INSTRUMENTS_FILE, args)
+    elif folder or source.suffix == ".npz":
         rec = _run_recording(source, args)
+    elif run_signals:
+        raise InputError(f"--run-signals: {label} {source} is a file; it applies to a run's folder")
     else:
         from gearbody.recording.files import read_recording
 
@@ -188,6 +203,40 @@ def _units_and_calibration(args) -> dict:
             ) from None
         out["calibration"] = values[0] if len(values) == 1 else values
     return out
+
+
+def _instruments_recording(path: Path, args):
+    """The virtual recording a run wrote (``gearbody run`` of a scenario with [instruments]): read as a
+    logger's file, over the run's last quarter unless --start/--end say otherwise."""
+    from gearbody.errors import InputError
+    from gearbody.recording.files import read_recording
+    from gearbody.result import FINAL_FRACTION
+
+    given = [
+        o
+        for o, v in (
+            ("--unit", args.unit),
+            ("--calibration", args.calibration),
+            ("--sample-rate", args.sample_rate),
+            ("--tacho", args.tacho),
+            ("--pulses-per-rev", args.pulses_per_rev),
+            ("--tacho-shaft", args.tacho_shaft),
+        )
+        if v is not None and v != []
+    ]
+    if given:
+        raise InputError(
+            f"{', '.join(given)}: the run's virtual instruments ({path}) carry their units, rate and "
+            "tacho ([instruments] of its scenario); --run-signals analyses the run's own signals, where "
+            "--tacho-shaft and --pulses-per-rev choose the virtual tacho"
+        )
+    rec = read_recording(path)
+    if args.start is not None or args.end is not None:
+        return rec.window(args.start, args.end)
+    t = rec.time_s
+    rec = rec.window(float(t[-1] - FINAL_FRACTION * (t[-1] - t[0])), None)
+    rec.meta["window_note"] = f"the last {FINAL_FRACTION:.0%} of the run"
+    return rec
 
 
 def _run_recording(source: Path, args):
@@ -253,6 +302,7 @@ def execute(args) -> int:
         "end",
         "no_envelope",
         "prewhiten",
+        "run_signals",
         "unit",
         "calibration",
     )
@@ -264,6 +314,8 @@ def execute(args) -> int:
         folder.begin()
         paths = write_diagnosis(diag, out, title=f"{Path(args.recording).name} on {drive.scene}")
         folder.finish()
+    if rec.meta.get("source") == "virtual instruments":
+        print(f"the run's virtual instruments ({INSTRUMENTS_FILE}; --run-signals: the run's own signals)")
     print(
         f"analysed {', '.join(diag.channels)} of {args.recording}: input shaft "
         f"{diag.mean_input_hz:.4f} rev/s "

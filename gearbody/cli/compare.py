@@ -23,7 +23,8 @@ def register(sub) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description=(
             "Analyse RUN (a run folder or its result.npz: its steady last quarter) and RECORDING (a file "
-            "'gearbody analyze' reads, or another run) with the same drive and write DIR/comparison.html, "
+            "'gearbody analyze' reads, or another run: a run folder holding instruments.mat, its virtual "
+            "instruments) with the same drive and write DIR/comparison.html, "
             "comparison.json and comparison.csv (every feature of both with the ratio recording / run) and "
             "overlay_orders.png (both order spectra, labelled by the drive's lines). The drive is --scene, "
             "else the run's scenario."
@@ -63,6 +64,7 @@ def execute(args) -> int:
             "unit": [],
             "calibration": None,
             "scene": None,
+            "run_signals": True,  # RUN: the run's own signals (RECORDING may be a run's virtual instruments)
         }
     )
     run_rec, run_scenario = open_recording(run_args, args.run)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 
 from .common import (
@@ -37,7 +38,9 @@ def register(sub) -> argparse.ArgumentParser:
             "stage K_d over time and folded over the mesh period (stage k > 1: kd_time_stage_k.png, "
             "...), the spectrum of the pinion acceleration (lateral: housing acceleration) when the "
             "first stage is parallel, per planetary stage the planets' K_d, the load sharing and the "
-            "ring-sensor spectrum. DIR must be empty, hold a run of the same resolved scenario (it is "
+            "ring-sensor spectrum. A scenario with an [instruments] table also gets DIR/instruments.mat: "
+            "its virtual accelerometers and tacho as a recording ('gearbody analyze DIR' analyses it; "
+            "docs/recordings.md). DIR must be empty, hold a run of the same resolved scenario (it is "
             "written again) or be replaced with --overwrite; DIR/.gearbody.json records the run."
         ),
     )
@@ -65,6 +68,9 @@ def register(sub) -> argparse.ArgumentParser:
     run.set_defaults(handler=execute)
     return run
 
+
+INSTRUMENTS_FILE = "instruments.mat"
+"""The run's virtual recording (MATLAB v5: scipy writes it, every tool reads it; bit-exact for gearbody)."""
 
 PLANETARY_SHOWN = (
     "kd_max",
@@ -98,6 +104,15 @@ def check_plottable(scenario, args) -> None:
     )
 
 
+def bearing_marks(result) -> list:
+    """The bearing defect frequencies (BPFO, BPFI, 2 BSF, FTF of every bearing with geometry) at the run's
+    mean input speed over its final window, for its spectrum plot (none when the run has no scenario)."""
+    from gearbody.reports.bearings import run_bearing_section
+
+    section, input_hz = run_bearing_section(result)
+    return section.marks(input_hz, float("inf"))
+
+
 def execute(args) -> int:
     out = check_out(args.out or default_out(args.scene))  # before anything is imported or run
     from gearbody.engine import simulate
@@ -107,6 +122,10 @@ def execute(args) -> int:
     scenario = load(args.scene, scenario_overrides(args), scenario_labels(args))
     if not args.no_plots or args.report:
         check_plottable(scenario, args)
+    if scenario.instruments is not None:  # force signals, tacho shaft, FRF files: before the run
+        from gearbody.diagnosis.virtual import check_instruments
+
+        check_instruments(scenario)
     check_wall_time(scenario, args)
     identity = {"scenario": scenario_to_dict(scenario)}  # what makes a run the same run
     with claim(out, "run", identity, overwrite=args.overwrite) as folder:  # locked while it writes
@@ -119,11 +138,19 @@ def execute(args) -> int:
         summary["wall_time_s"] = time.perf_counter() - t0
         write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
         warn_if_backwards(result)
-        plots = [] if args.no_plots else result.plot(out)
+        plots = [] if args.no_plots else result.plot(out, marks=bearing_marks(result))
         if args.report:
             from gearbody.reports.html import write_report
 
             write_report(result, out / "report.html")
+        if scenario.instruments is not None:
+            from gearbody.diagnosis.virtual import virtual_recording
+            from gearbody.recording.files import write_recording
+
+            recording = virtual_recording(result, scenario)
+            write_recording(recording, out / INSTRUMENTS_FILE)
+            if recording.tacho is None:
+                print(f"gearbody: note: {recording.meta['tacho_note']}", file=sys.stderr)
         folder.finish()
     if not args.quiet:
         print(f"{scenario.meta.title}")
@@ -152,5 +179,6 @@ def execute(args) -> int:
             f"wrote {out}/result.npz, scenario.toml, summary.json"
             + (f", {len(plots)} plots" if plots else "")
             + (", report.html" if args.report else "")
+            + (f", {INSTRUMENTS_FILE}" if scenario.instruments is not None else "")
         )
     return EXIT_OK

@@ -52,6 +52,8 @@ class DriveKinematics:
     input_body: str = "pinion"
     nominal_input_hz: float | None = None
     """The input shaft's speed with the motor at its synchronous speed [rev/s] (None: Muller's model)."""
+    bearings_without_geometry: tuple[str, ...] = ()
+    """Rolling bearings of the scenario that state no geometry: ``"<name> (<its geometry key>)"``."""
 
     @classmethod
     def from_scenario(cls, scenario) -> DriveKinematics:
@@ -74,7 +76,11 @@ class DriveKinematics:
         ratios = {body: w / w_in for body, w in speeds.items()}
         gears = tuple(_gears(stages, ratios))
         bearings = tuple(_bearings(scenario, ratios))
-        return cls(str(scenario.meta.name or ""), ratios, stages, gears, bearings, input_body, nominal)
+        finder = getattr(scenario, "rolling_bearings", None)
+        missing = tuple(f"{b.name} ({b.key})" for b in (finder() if finder else []) if b.geometry is None)
+        return cls(
+            str(scenario.meta.name or ""), ratios, stages, gears, bearings, input_body, nominal, missing
+        )
 
     # -- speeds and angles ---------------------------------------------------------------------------
     def bodies(self) -> list[str]:
@@ -116,7 +122,7 @@ class DriveKinematics:
             lines += gear_train_lines(input_hz, teeth, f_max_hz, harmonics=harmonics, sidebands=sidebands)
         else:
             lines += self._compound_lines(input_hz, f_max_hz, harmonics, sidebands)
-        lines += self._bearing_lines(input_hz, f_max_hz)
+        lines += self.bearing_lines(input_hz, f_max_hz)
         return sorted(lines, key=lambda line: line.frequency_hz)
 
     def _compound_lines(self, input_hz: float, f_max_hz: float, harmonics: int, sidebands: int) -> list:
@@ -164,22 +170,33 @@ class DriveKinematics:
         flush()
         return out
 
-    def _bearing_lines(self, input_hz: float, f_max_hz: float) -> list[KinematicLine]:
+    def bearing_frequencies(self, input_hz: float) -> list[tuple[BearingLineSource, Any]]:
+        """(bearing, its :class:`~gearbody.analysis.bearing_lines.BearingFrequencies`) of every bearing
+        with geometry that turns, the input shaft at ``input_hz`` (1: in orders of the input shaft); its
+        ``shaft_hz`` is the speed of its body relative to its reference."""
         from ..analysis.bearing_lines import bearing_frequencies
 
         out = []
         for b in self.bearings:
             shaft_hz = abs(self.speed_ratios[b.body] - self.speed_ratios.get(b.reference, 0.0)) * input_hz
-            if shaft_hz <= 0:
-                continue
-            freqs = bearing_frequencies(b.geometry, shaft_hz, outer_race_rotates=b.outer_race_rotates)
+            if shaft_hz > 0:
+                out.append(
+                    (b, bearing_frequencies(b.geometry, shaft_hz, outer_race_rotates=b.outer_race_rotates))
+                )
+        return out
+
+    def bearing_lines(self, input_hz: float, f_max_hz: float, harmonics: int = 2) -> list[KinematicLine]:
+        """Each bearing's BPFO, BPFI, 2 BSF (a rolling element's defect strikes both races) and FTF with
+        ``harmonics`` (1 or 2) harmonics in (0, ``f_max_hz``], the input shaft at ``input_hz``."""
+        out = []
+        for b, freqs in self.bearing_frequencies(input_hz):
             for symbol, f, first in (
                 ("BPFO", freqs.bpfo_hz, 1),
                 ("BPFI", freqs.bpfi_hz, 1),
-                ("BSF", freqs.bsf_hz, 2),  # a rolling element's defect strikes both races: 2 BSF
+                ("BSF", freqs.bsf_hz, 2),
                 ("FTF", freqs.ftf_hz, 1),
             ):
-                for k in (first, 2 * first):
+                for k in (first, 2 * first)[:harmonics]:
                     if 0 < k * f <= f_max_hz:
                         label = f"{'' if k == 1 else f'{k} '}{symbol} {b.name}"
                         out.append(KinematicLine(k * f, label, "bearing", ((f"{symbol} {b.name}", k),)))

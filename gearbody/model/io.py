@@ -303,7 +303,7 @@ def load_scenario(
     canonical shape or the single-stage shorthand), with optional ``KEY=VALUE`` overrides; errors
     caused by an override quote it as typed (``labels``: one per override, default ``--set KEY=VALUE``)."""
     if isinstance(source, dict):
-        data, name, stem = source, "<dict>", ""
+        data, name, stem, folder = source, "<dict>", "", None
         if nesting_depth(data) > MAX_NESTING:
             raise _too_deep(name)
     else:
@@ -313,13 +313,29 @@ def load_scenario(
         # a file name that is not UTF-8 (bytes kept as surrogates) names the scenario with U+FFFD in
         # their place: meta.name is written into scenario.toml and summary.json, which are UTF-8
         stem = path.stem.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
-        data, name = read_toml(path), str(path)
+        data, name, folder = read_toml(path), str(path), path.parent
     data, aliases = canonical_form(data, name)
+    anchor_files(data, folder)
     data, more, origins = apply_overrides(data, overrides, labels)
+    anchor_files(data, None)  # what an override names, from where it was typed
     meta = data.setdefault("meta", {})
     if isinstance(meta, dict) and not meta.get("name") and stem:
         meta["name"] = stem
     return from_dict(Scenario, data, source=name, aliases={**aliases, **more}, origins=origins)
+
+
+def anchor_files(data: dict[str, Any], folder: Path | None) -> None:
+    """Make every relative ``instruments.accelerometers.N.frf_file`` of ``data`` absolute against
+    ``folder`` (a scene file's folder; None: the working folder, for a dict and for overrides), in place, so a
+    resolved scenario (a run's scenario.toml) names the same file wherever it is read. Anything not of the
+    table's shape is left for validation to name."""
+    instruments = data.get("instruments")
+    items = instruments.get("accelerometers") if isinstance(instruments, dict) else None
+    for item in items if isinstance(items, list) else []:
+        text = item.get("frf_file") if isinstance(item, dict) else None
+        if isinstance(text, str) and text.strip() and not os.path.isabs(text):
+            base = os.getcwd() if folder is None else os.path.abspath(folder)
+            item["frf_file"] = os.path.normpath(os.path.join(base, text))
 
 
 def scenario_to_dict(scenario: Scenario) -> dict[str, Any]:

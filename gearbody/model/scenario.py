@@ -24,6 +24,7 @@ from .budget import check_resources
 from .checks import check_planetary_in_drive, check_stage, check_topology, check_turning_senses
 from .components import Gear, Machine, Motor, RollingBearingSpec, Shaft
 from .faults import DamagedTooth, Eccentricity, ErrorMode, PittedTooth
+from .instruments import Instruments, check_instruments_in_run
 from .kinds import register_stage_kind, stage_kind
 from .mesh import Mesh
 from .operation import Operation
@@ -175,7 +176,8 @@ class Visual(Node):
 @dataclass(frozen=True, kw_only=True)
 class Scenario(Node):
     """Everything a run is made of, as the TOML tables of a scene: ``meta``, ``design`` (motor, stages,
-    machine), ``operation``, ``condition``, ``solver`` and ``visual``. Immutable; validated when built
+    machine), ``operation``, ``condition``, ``solver``, ``visual`` and the optional ``instruments`` (virtual
+    sensors, evaluated after the solve). Immutable; validated when built
     (a :class:`~gearbody.errors.ScenarioError` names the key); ``replace``/``with_stage`` make
     changed copies. :func:`~gearbody.model.load_scenario` reads one."""
 
@@ -185,6 +187,9 @@ class Scenario(Node):
     condition: Condition = param(default_factory=Condition)
     solver: Solver = param(default_factory=Solver)
     visual: Visual = param(default_factory=Visual)
+    instruments: Instruments | None = param(
+        None, doc="virtual housing accelerometers and a tacho, recorded after the solve (docs/scenario.md)"
+    )
 
     @classmethod
     def prepare_fields(cls, fields: dict[str, Any]) -> dict[str, Any]:
@@ -254,6 +259,8 @@ class Scenario(Node):
                 f"solver.output_rate_hz = {self.solver.output_rate_hz}: gives fewer than 2 "
                 f"samples over t_end_s = {self.operation.t_end_s}"
             )
+        if self.instruments is not None:
+            check_instruments_in_run(self.instruments, self.solver.output_rate_hz)
         check_resources(self)
 
     # -- derived quantities used everywhere ------------------------------------------------

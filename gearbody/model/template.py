@@ -45,7 +45,7 @@ UNITS = (
 )
 """Unit of a key from the end of its name (gearbody's names carry their units)."""
 
-ARRAYS_OF_TABLES = ("stages", "shafts")
+ARRAYS_OF_TABLES = ("stages", "shafts", "accelerometers")
 """List keys written as ``[[...]]`` tables (the chain); other lists of tables are written inline."""
 
 UNSET = "not set"
@@ -276,7 +276,12 @@ def commented_toml(
             continue
         w.scalar(meta, f, ["meta"], typing.get_type_hints(type(meta))[f.name])
     for f in dataclasses.fields(scenario):
-        if f.name != "meta":
-            w.table(getattr(scenario, f.name), [f.name], f.name)
+        if f.name == "meta":
+            continue
+        if getattr(scenario, f.name) is None:  # an optional section the scenario leaves out
+            w.lines.append("")
+            w.comment(f"[{f.name}]: {UNSET}; {_describe(f)}")
+            continue
+        w.table(getattr(scenario, f.name), [f.name], f.name)
     lines = [ln if ln.strip() != "#" else "#" for ln in w.lines]
     return "\n".join(lines).lstrip("\n") + "\n"

@@ -18,7 +18,7 @@ from gearbody.analysis.ring_sensor import equally_spaced, ring_sensor_spectrum
 from ..signals import stage_file_tag, stage_prefix
 from .figure import new_figure, save_figure, set_title
 from .result import plot_signals
-from .spectrum import plot_labelled_spectrum
+from .spectrum import mark_lines, plot_labelled_spectrum
 
 if TYPE_CHECKING:
     from gearbody.result import Result
@@ -31,9 +31,10 @@ CANCELLED_CAPTION = (
 )
 
 
-def write_planetary_plots(result: Result, out_dir: str | Path) -> list[Path]:
+def write_planetary_plots(result: Result, out_dir: str | Path, marks=()) -> list[Path]:
     """Per planetary stage: planet mesh K_d over time, mean planet mesh forces (sharing), and the
-    ring-sensor spectrum over its window of whole carrier revolutions with its labelled peaks."""
+    ring-sensor spectrum over its window of whole carrier revolutions with its labelled peaks (and
+    ``marks``, lines such as bearing defect frequencies)."""
     out = Path(out_dir)
     title = result.meta.get("title", result.meta.get("scene", ""))
     paths = []
@@ -80,5 +81,6 @@ def write_planetary_plots(result: Result, out_dir: str | Path) -> list[Path]:
         )
         if equally_spaced(result, k):
             ax.text(0.01, 0.98, CANCELLED_CAPTION, transform=ax.transAxes, fontsize=7, color="0.4", va="top")
+        mark_lines(ax, marks, ring.f_max_hz)
         paths.append(save_figure(ax.figure, out / f"ring_sensor_spectrum{tag}.png"))
     return paths

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .figure import new_figure, set_title
-from .spectrum import plot_labelled_spectrum
+from .spectrum import mark_lines, plot_labelled_spectrum, spectrum_panels
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -45,15 +45,18 @@ def reduced(spectrum, x_max: float):
     return Spectrum(f, a, spectrum.sample_rate_hz, spectrum.window, spectrum.n_samples)
 
 
-def order_spectrum_figure(spec, peaks, title: str, unit: str, max_order: float) -> Figure:
-    """An order spectrum (``spec.frequency_hz`` holds orders) with its labelled peaks."""
-    fig = new_figure((1100, 500), 100)
-    ax = fig.add_subplot(1, 1, 1)
+def order_spectrum_figure(spec, peaks, title: str, unit: str, max_order: float, marks=()) -> Figure:
+    """An order spectrum (``spec.frequency_hz`` holds orders) with its labelled peaks and ``marks`` (lines
+    in orders, :func:`~gearbody.plotting.spectrum.mark_lines`; a panel below shows them apart when they
+    crowd the foot of the axis)."""
+    fig, ax, low = spectrum_panels(reduced(spec, max_order), peaks, marks, max_order, unit)
     plot_labelled_spectrum(reduced(spec, max_order), peaks, ax=ax, title=title, unit=unit, f_max_hz=max_order)
-    ax.set_xlabel("order of the input shaft [cycles/rev]")
-    for text in ax.texts:  # an unexplained peak's label is its order, not Hz
-        if text.get_text().endswith(" Hz"):
-            text.set_text(text.get_text()[:-3])
+    mark_lines(ax, marks, max_order, labels=low is None)
+    for axes in fig.axes:
+        axes.set_xlabel("order of the input shaft [cycles/rev]")
+        for text in axes.texts:  # an unexplained peak's label is its order, not Hz
+            if text.get_text().endswith(" Hz"):
+                text.set_text(text.get_text()[:-3])
     return fig
 
 
@@ -73,8 +76,8 @@ def shaft_tsa_figure(tsa, channel: str, body: str, unit: str = "") -> Figure:
     return fig
 
 
-def envelope_figure(spec, peaks, title: str, unit: str, f_max_hz: float) -> Figure:
-    """The envelope spectrum with its labelled peaks (bearing lines, shaft orders)."""
+def envelope_figure(spec, peaks, title: str, unit: str, f_max_hz: float, marks=()) -> Figure:
+    """The envelope spectrum with its labelled peaks (bearing lines, shaft orders) and ``marks``."""
     from dataclasses import replace
 
     fig = new_figure((1100, 450), 100)
@@ -85,6 +88,7 @@ def envelope_figure(spec, peaks, title: str, unit: str, f_max_hz: float) -> Figu
     spec = replace(spec, amplitude=amplitude)
     plot_labelled_spectrum(spec, peaks, ax=ax, title=title, unit=unit, f_max_hz=f_max_hz, log=False)
     ax.set_xlabel("envelope frequency [Hz]")
+    mark_lines(ax, marks, f_max_hz)
     return fig
 
 
@@ -140,25 +144,27 @@ def rpm_order_figure(rpm_map, title: str, unit: str) -> Figure:
 
 
 def overlay_figure(
-    spectra: list, labels: list[str], peaks, title: str, unit: str, max_order: float
+    spectra: list, labels: list[str], peaks, title: str, unit: str, max_order: float, marks=()
 ) -> Figure:
-    """Order spectra of a run and a recording overlaid (the first one's peaks labelled)."""
-    fig = new_figure((1100, 500), 100)
-    ax = fig.add_subplot(1, 1, 1)
-    plot_labelled_spectrum(
-        reduced(spectra[0], max_order), peaks, ax=ax, title=title, unit=unit, f_max_hz=max_order
-    )
+    """Order spectra of a run and a recording overlaid (the first one's peaks labelled; ``marks``: lines
+    in orders, shown apart in a panel below when they crowd the foot of the axis)."""
+    first = reduced(spectra[0], max_order)
+    fig, ax, low = spectrum_panels(first, peaks, marks, max_order, unit)
+    plot_labelled_spectrum(first, peaks, ax=ax, title=title, unit=unit, f_max_hz=max_order)
     ax.lines[0].set_label(labels[0])
     for spec, label, colour in zip(spectra[1:], labels[1:], ("tab:orange", "tab:green"), strict=False):
         s = reduced(spec, max_order)
-        ax.plot(
-            s.frequency_hz,
-            np.where(s.amplitude > 0, s.amplitude, np.nan),
-            lw=0.6,
-            color=colour,
-            alpha=0.8,
-            label=label,
-        )
-    ax.set_xlabel("order of the input shaft [cycles/rev]")
+        for axes in (ax, low) if low is not None else (ax,):
+            axes.plot(
+                s.frequency_hz,
+                np.where(s.amplitude > 0, s.amplitude, np.nan),
+                lw=0.6,
+                color=colour,
+                alpha=0.8,
+                label=label,
+            )
+    mark_lines(ax, marks, max_order, labels=low is None)
+    for axes in fig.axes:
+        axes.set_xlabel("order of the input shaft [cycles/rev]")
     ax.legend(loc="upper right", fontsize=8)
     return fig

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .figure import new_figure, set_title
-from .spectrum import plot_labelled_spectrum
+from .spectrum import mark_lines, plot_labelled_spectrum, spectrum_panels
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -20,12 +20,14 @@ __all__ = ["kd_folded_figure", "labelled_spectrum_figure", "tsa_figure"]
 
 
 def labelled_spectrum_figure(
-    spec: Spectrum, peaks: list[LabelledPeak], title: str, unit: str, f_max_hz: float
+    spec: Spectrum, peaks: list[LabelledPeak], title: str, unit: str, f_max_hz: float, marks=()
 ) -> Figure:
-    """The spectrum with its labelled peaks (:func:`gearbody.plotting.spectrum.plot_labelled_spectrum`)."""
-    fig = new_figure((1100, 500), 100)
-    ax = fig.add_subplot(1, 1, 1)
+    """The spectrum with its labelled peaks (:func:`gearbody.plotting.spectrum.plot_labelled_spectrum`)
+    and ``marks`` (lines, e.g. bearing defect frequencies, :func:`~gearbody.plotting.spectrum.mark_lines`;
+    a panel below shows them apart when they crowd the foot of the axis)."""
+    fig, ax, low = spectrum_panels(spec, peaks, marks, f_max_hz, unit)
     plot_labelled_spectrum(spec, peaks, ax=ax, title=title, unit=unit, f_max_hz=f_max_hz)
+    mark_lines(ax, marks, f_max_hz, labels=low is None)
     return fig
 
 

@@ -144,6 +144,7 @@ def spectrum_figure(
     max_harmonics: int = 20,
     size_px: tuple[int, int] = DEFAULT_SIZE_PX,
     dpi: int = 100,
+    marks: Sequence = (),
 ) -> Figure:
     """The figure of :func:`plot_spectrum` (same arguments but ``path``), not saved.
 
@@ -154,6 +155,8 @@ def spectrum_figure(
     by green lines labelled inside it with the mapping keys (plain text) or f_s1, f_s2, ... and their
     frequency. Long titles wrap. ``log_amplitude`` uses log y axes (bins below 1e-9 of the maximum are
     clipped to it). Pass ``ylabel`` with the signal's unit, e.g. "Acceleration amplitude [m/s^2]".
+    ``marks`` (lines such as bearing defect frequencies) are drawn by
+    :func:`gearbody.plotting.spectrum.mark_lines` in the upper panel.
     """
     fmax = float(spectrum.frequency_hz[-1]) if fmax_hz is None else float(fmax_hz)
     shown = spectrum.frequency_hz <= fmax
@@ -177,16 +180,18 @@ def spectrum_figure(
         ax, low = fig.add_subplot(), None
     _spectrum_axes(ax, freq, amp, log_amplitude, (0.0, fmax), ylabel)
 
-    marks: list[tuple] = []  # (axes, labels, colour): labelled once the layout is final
+    labelled: list[tuple] = []  # (axes, labels, colour): labelled once the layout is final
     if mesh_frequency_hz is not None:
         harmonics = mesh_harmonics(mesh_frequency_hz, fmax)[:max_harmonics]
         names = harmonic_labels(harmonics.size)
         for f in harmonics:
             ax.axvline(f, color="tab:red", linestyle="--", linewidth=0.8, alpha=0.8)
-        marks.append((ax, [(f"${n}$", float(f)) for f, n in zip(harmonics, names, strict=True)], "tab:red"))
+        labelled.append(
+            (ax, [(f"${n}$", float(f)) for f, n in zip(harmonics, names, strict=True)], "tab:red")
+        )
 
-    if low is not None:
-        f_low = min(fmax, SHAFT_PANEL_ORDERS * shown_shafts[-1][1])
+    if low is not None:  # the shaft frequencies, and bearing lines up to 10 shaft orders
+        f_low = _low_panel_top(fmax, shown_shafts[-1][1], marks)
         inside = freq <= f_low
         _spectrum_axes(low, freq[inside], amp[inside], log_amplitude, (0.0, f_low), ylabel)
         resolution = f", bins of {freq[1] - freq[0]:.3g} Hz" if freq.size > 1 else ""
@@ -195,14 +200,31 @@ def spectrum_figure(
         styles = (":", "-.", (0, (1, 3)), (0, (5, 2, 1, 2)))
         for i, (_, f) in enumerate(shown_shafts):
             low.axvline(f, color="tab:green", linestyle=styles[i % len(styles)], linewidth=1.2)
-        marks.append((low, [(f"{label} = {f:.4g} Hz", f) for label, f in shown_shafts], "tab:green"))
+        labelled.append((low, [(f"{label} = {f:.4g} Hz", f) for label, f in shown_shafts], "tab:green"))
 
     if title:
         set_title(ax, title, pad=6)
     fig.draw_without_rendering()  # the final layout: labels inside the axes are measured in it
-    for axes, labels, colour in marks:
+    for axes, labels, colour in labelled:
         _marker_labels(axes, labels, colour)
+    _mark(ax, low, marks, fmax)
     return fig
+
+
+def _low_panel_top(fmax: float, fastest_shaft_hz: float, marks: Sequence) -> float:
+    """The low panel's top: SHAFT_PANEL_ORDERS shaft orders, widened to the marks up to 10 of them."""
+    crowded = [float(m.frequency_hz) for m in marks if 0 < m.frequency_hz <= 10 * fastest_shaft_hz]
+    return min(fmax, max(SHAFT_PANEL_ORDERS * fastest_shaft_hz, 1.1 * max(crowded, default=0.0)))
+
+
+def _mark(ax, low, marks: Sequence, fmax: float) -> None:
+    """``marks`` on the spectrum: labelled in the low panel when there is one, else in ``ax``."""
+    from .spectrum import mark_lines
+
+    if marks:
+        mark_lines(ax, marks, fmax, labels=low is None)
+        if low is not None:
+            mark_lines(low, marks, low.get_xlim()[1])
 
 
 def _spectrum_axes(ax, freq, amp, log_amplitude: bool, xlim: tuple[float, float], ylabel: str) -> None:
@@ -278,6 +300,7 @@ def plot_spectrum(
     max_harmonics: int = 20,
     size_px: tuple[int, int] = DEFAULT_SIZE_PX,
     dpi: int = 100,
+    marks: Sequence = (),
 ) -> Path:
     """Amplitude spectrum against frequency [Hz] as PNG at ``path`` (:func:`spectrum_figure`)."""
     fig = spectrum_figure(
@@ -291,5 +314,6 @@ def plot_spectrum(
         max_harmonics,
         size_px,
         dpi,
+        marks,
     )
     return save_figure(fig, path, dpi)

@@ -37,10 +37,11 @@ def parallel_stage_plot_names(result: Result) -> list[str]:
     return names
 
 
-def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
+def write_plots(result: Result, out_dir: str | Path, marks=()) -> list[Path]:
     """Per parallel stage: K_d over time and folded over its mesh period (final window); when the first
-    stage is parallel, the spectrum of the vibration signal (``spectrum.png``); bearing forces of lateral
-    gears. A drive without parallel stages gets none of these."""
+    stage is parallel, the spectrum of the vibration signal (``spectrum.png``, ``marks`` drawn on it:
+    lines such as bearing defect frequencies); bearing forces of lateral gears. A drive without parallel
+    stages gets none of these."""
     out = Path(out_dir)
     title = result.meta.get("title", result.meta.get("scene", ""))
     paths: list[Path] = []
@@ -48,7 +49,7 @@ def write_plots(result: Result, out_dir: str | Path) -> list[Path]:
         if st.has_kd_plots:
             paths += _stage_kd_plots(result, k, out, title)
     if result.stages[0].gear_pair() is not None:
-        paths.append(_spectrum_plot(result, out, title))
+        paths.append(_spectrum_plot(result, out, title, marks))
     # parallel gears on lateral bearings (a drive with planetary stages has none: its bearing forces are
     # the planetary members')
     gears = [] if result.planetary_stages else result.bearing_gears
@@ -96,7 +97,7 @@ def _stage_kd_plots(result: Result, stage: int, out: Path, title: str) -> list[P
     return paths
 
 
-def _spectrum_plot(result: Result, out: Path, title: str) -> Path:
+def _spectrum_plot(result: Result, out: Path, title: str, marks=()) -> Path:
     """Spectrum of the vibration signal over the final window, first stage's mesh harmonics and shafts."""
     win = result.final_window()
     f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
@@ -116,4 +117,5 @@ def _spectrum_plot(result: Result, out: Path, title: str) -> Path:
         fmax_hz=min(result.sample_rate_hz / 2, 8.5 * f_mesh if f_mesh > 0 else 1e9),
         ylabel=f"amplitude [{unit}]",
         log_amplitude=True,
+        marks=marks,
     )

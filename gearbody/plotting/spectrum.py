@@ -19,7 +19,10 @@ from .figure import drop_overlapping, new_figure, set_title
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-__all__ = ["plot_labelled_spectrum"]
+__all__ = ["LINE_COLOURS", "mark_lines", "plot_labelled_spectrum", "spectrum_panels", "zoom_limit"]
+
+LINE_COLOURS = {"BPFO": "tab:purple", "BPFI": "tab:brown", "BSF": "tab:olive", "FTF": "tab:cyan"}
+"""Colour of a marked line by the symbol its label names (bearing lines); others are grey."""
 
 
 def _cancelled(peak: LabelledPeak) -> bool:
@@ -100,3 +103,72 @@ def plot_labelled_spectrum(
         set_title(ax, title)
     drop_overlapping(labels, within=ax)
     return ax
+
+
+def zoom_limit(lines: Sequence, x_max: float) -> float | None:
+    """The upper end of a panel that shows ``lines`` apart (1.15 x the highest one), when every line in
+    (0, ``x_max``] lies below a quarter of ``x_max`` (bearing lines on a spectrum of mesh harmonics);
+    None otherwise."""
+    inside = [float(line.frequency_hz) for line in lines if 0 < float(line.frequency_hz) <= x_max]
+    if not inside or max(inside) >= x_max / 4:
+        return None
+    return min(x_max, 1.15 * max(inside))
+
+
+def spectrum_panels(spectrum: Spectrum, peaks, lines: Sequence, x_max: float, unit: str, size_px=(1100, 500)):
+    """(figure, main axes, zoom panel or None): one axes, or, when ``lines`` crowd the foot of the axis
+    (:func:`zoom_limit`), a second panel below it showing the spectrum from 0 to the lines' zoom limit
+    with its peaks and the lines labelled (mark the main axes' lines without labels; its zoomed span is
+    shaded). The caller draws the main axes; this draws the panel."""
+    from .figure import new_figure
+
+    low_max = zoom_limit(lines, x_max)
+    if low_max is None:
+        fig = new_figure(size_px, 100)
+        return fig, fig.add_subplot(1, 1, 1), None
+    fig = new_figure((size_px[0], size_px[1] + 330), 100)
+    grid = fig.add_gridspec(2, 1, height_ratios=(2.0, 1.2))  # the panel holds its peaks' labels
+    ax, low = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])
+    kept = [p for p in peaks if p.frequency_hz <= low_max]
+    plot_labelled_spectrum(spectrum, kept, ax=low, unit=unit, f_max_hz=low_max)
+    set_title(low, f"0-{low_max:.4g}: the bearing lines apart", fontsize=9, pad=3)
+    mark_lines(low, lines, low_max)
+    ax.axvspan(0.0, low_max, color="tab:purple", alpha=0.08, linewidth=0)
+    return fig, ax, low
+
+
+def mark_lines(ax: Axes, lines: Sequence, x_max: float | None = None, labels: bool = True) -> list:
+    """Mark ``lines`` (each with ``frequency_hz`` and ``label``: a
+    :class:`~gearbody.analysis.KinematicLine`, in Hz or in orders as the axes are) on ``ax`` where they
+    fall inside (0, ``x_max``] (default: the axes' right edge): a dotted vertical line in the colour of
+    its symbol (:data:`LINE_COLOURS`) and its label, rotated, at the foot of the axes (a label that would
+    overlap another is left out; every line keeps its mark; ``labels=False``: marks only). Returns the
+    labels drawn."""
+    from matplotlib.transforms import blended_transform_factory
+
+    top = ax.get_xlim()[1] if x_max is None else float(x_max)
+    transform = blended_transform_factory(ax.transData, ax.transAxes)
+    drawn = []
+    for line in sorted(lines, key=lambda line: line.frequency_hz):
+        f = float(line.frequency_hz)
+        if not 0 < f <= top:
+            continue
+        colour = next((c for symbol, c in LINE_COLOURS.items() if symbol in line.label.split()), "0.4")
+        ax.axvline(f, color=colour, linestyle=":", linewidth=0.9, alpha=0.9, zorder=0.5)
+        if not labels:
+            continue
+        text = ax.text(
+            f,
+            0.015,
+            line.label,
+            transform=transform,
+            rotation=90,
+            fontsize=6,
+            ha="right",
+            va="bottom",
+            color=colour,
+            bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.7, "pad": 0.3},
+            in_layout=False,
+        )
+        drawn.append(text)
+    return drop_overlapping(drawn, within=ax)

@@ -18,7 +18,8 @@ from gearbody.folders import atomic_write, write_text
 from gearbody.plotting.figure import png_bytes
 from gearbody.plotting.recording import overlay_figure
 
-from .html import _table
+from .bearings import bearing_section
+from .html import _table, bearing_html
 from .recording import STYLE
 
 __all__ = ["write_comparison"]
@@ -40,6 +41,13 @@ def write_comparison(comparison, out: str | Path, title: str) -> list[Path]:
     writer.writerows(comparison.rows)
     write_text(out / "comparison.csv", buffer.getvalue())
     run, rec = comparison.run_side, comparison.recording_side
+    bearings = bearing_section(
+        comparison.run.drive,
+        {
+            "at the run's mean input speed": comparison.run.mean_input_hz,
+            "at the recording's mean input speed": comparison.recording.mean_input_hz,
+        },
+    )
     written = []
     image = ""
     if run.order_spectrum is not None and rec.order_spectrum is not None:
@@ -58,6 +66,7 @@ def write_comparison(comparison, out: str | Path, title: str) -> list[Path]:
             f"order spectra, run and recording{note}",
             unit,
             max_order,
+            marks=bearings.marks(1.0, max_order),
         )
         data = png_bytes(fig)  # drawn once, written and embedded
         image = base64.b64encode(data).decode("ascii")
@@ -75,6 +84,7 @@ def write_comparison(comparison, out: str | Path, title: str) -> list[Path]:
         f"<code>{html.escape(comparison.run.drive.scene)}</code>.</p>",
         "<h2>Order spectra</h2>",
         f'<img src="data:image/png;base64,{image}" alt="overlay">' if image else "<p>no order spectrum</p>",
+        bearing_html(bearings),
         "<h2>Features (ratio = recording / run)</h2>",
         _table(comparison.rows),
         "</body></html>",

@@ -1,4 +1,5 @@
-"""One self-contained HTML page per run: summary, labelled spectrum, folded K_d, TSA and indicators.
+"""One self-contained HTML page per run: summary, labelled spectrum (the bearings' defect frequencies
+marked), the bearings' fault frequencies, folded K_d, TSA and indicators.
 
 Engine-free: works on any :class:`~gearbody.result.Result` (simulated, or loaded from result.npz).
 Figures (drawn by :mod:`gearbody.plotting.report`) are embedded as base64 PNG, so the page can be
@@ -27,7 +28,7 @@ from gearbody.plotting.report import kd_folded_figure, labelled_spectrum_figure,
 from gearbody.result import Result
 from gearbody.signals import signal_unit
 
-__all__ = ["PEAK_COLUMNS", "report_sections", "spectrum_lines", "write_report"]
+__all__ = ["PEAK_COLUMNS", "bearing_html", "report_sections", "spectrum_lines", "write_report"]
 
 MIN_TSA_REVOLUTIONS = 2
 
@@ -72,19 +73,33 @@ def _table(
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
+def bearing_html(section) -> str:
+    """A page's section of the bearings' fault frequencies (a
+    :class:`~gearbody.reports.bearings.BearingSection`): heading, notes and the table."""
+    parts = ["<h2>Bearing fault frequencies</h2>", *(f"<p>{html.escape(n)}</p>" for n in section.notes)]
+    if section.rows:
+        parts.append(_table(section.rows, list(section.columns), section.columns))
+    return "\n".join(parts)
+
+
 def report_sections(result: Result) -> dict[str, Any]:
-    """The report's content as data: summary, labelled peaks, indicators, and figures (base64 PNG)."""
+    """The report's content as data: summary, labelled peaks, indicators, the bearings' fault frequencies
+    (``bearings``: a :class:`~gearbody.reports.bearings.BearingSection`; its lines marked on the
+    spectrum), and figures (base64 PNG)."""
+    from .bearings import run_bearing_section
+
+    bearings, input_hz = run_bearing_section(result)
     if result.planetary_stages:
         from .planetary import planetary_report_sections
 
-        return planetary_report_sections(result)
+        return {**planetary_report_sections(result, bearings, input_hz), "bearings": bearings}
     win = result.final_window()
     summary = result.summary()
     name = result.vibration_signal_name
     signal = result[name]
     z1 = int(result.meta["pinion_teeth"])
     f_mesh = float(np.mean(result["mesh_frequency_hz"][win]))
-    out: dict[str, Any] = {"summary": summary, "signal": name, "figures": {}}
+    out: dict[str, Any] = {"summary": summary, "signal": name, "figures": {}, "bearings": bearings}
 
     # the labelled spectrum of the vibration signal over the final window: Result.spectrum's, the one
     # composition of signal, window, lines and defaults
@@ -93,8 +108,9 @@ def report_sections(result: Result) -> dict[str, Any]:
     peaks = labelled.peaks
     if f_mesh > 0:
         title = f"spectrum of {name} [{unit}], last {result.FINAL_FRACTION:.0%} of the run"
+        marks = bearings.marks(input_hz, labelled.f_max_hz)
         fig = labelled_spectrum_figure(
-            labelled.spectrum, peaks, title=title, unit=unit, f_max_hz=labelled.f_max_hz
+            labelled.spectrum, peaks, title=title, unit=unit, f_max_hz=labelled.f_max_hz, marks=marks
         )
         out["figures"]["spectrum"] = png_base64(fig)
     out["peaks"] = peaks_to_rows(peaks)
@@ -158,6 +174,7 @@ def write_report(result: Result, path: str | Path) -> Path:
         _table(
             s["peaks"], list(PEAK_COLUMNS), {k: v.format(unit=s["unit"]) for k, v in PEAK_COLUMNS.items()}
         ),
+        bearing_html(s["bearings"]),
         "<h2>Synchronous average and condition indicators</h2>",
         img.get("tsa", f"<p>{html.escape(s.get('tsa_note', ''))}</p>"),
         _table([{"indicator": k, "value": v} for k, v in s["indicators"].items()]),

@@ -30,9 +30,13 @@ __all__ = ["planetary_report_sections"]
 MIN_TSA_REVOLUTIONS = 2
 
 
-def planetary_report_sections(result: Result) -> dict[str, Any]:
+def planetary_report_sections(
+    result: Result, bearings=None, input_hz: float = float("nan")
+) -> dict[str, Any]:
     """summary, signal, unit, peaks, indicators, figures (base64 PNG), the analysed window ("window") and,
-    when it cannot resolve the carrier sidebands, a note ("window_note") of a planetary run."""
+    when it cannot resolve the carrier sidebands, a note ("window_note") of a planetary run; the lines of
+    ``bearings`` (a :class:`~gearbody.reports.bearings.BearingSection`) at ``input_hz`` marked on the
+    ring-sensor spectrum."""
     k = result.planetary_stages[0]
     prefix = stage_prefix(k)
     meta = result.meta["stages"][k]
@@ -53,8 +57,11 @@ def planetary_report_sections(result: Result) -> dict[str, Any]:
     sources = ring.sources
     peaks = ring.peaks(min_prominence_db=12.0, max_peaks=40)
     title = ring.title(f"spectrum of {name} [N] (stage {k + 1})")
+    marks = bearings.marks(input_hz, ring.f_max_hz) if bearings is not None else []
     out["figures"]["spectrum"] = png_base64(
-        labelled_spectrum_figure(ring.spectrum, peaks, title=title, unit="N", f_max_hz=ring.f_max_hz)
+        labelled_spectrum_figure(
+            ring.spectrum, peaks, title=title, unit="N", f_max_hz=ring.f_max_hz, marks=marks
+        )
     )
     out["peaks"] = peaks_to_rows(peaks)
     # planet 1's sun mesh over its mesh period: the sun's angle relative to the carrier sets the phase

@@ -25,7 +25,7 @@ from gearbody.plotting.recording import (
 )
 from gearbody.plotting.report import labelled_spectrum_figure
 
-from .html import PEAK_COLUMNS, _table
+from .html import PEAK_COLUMNS, _table, bearing_html
 
 __all__ = ["diagnosis_figures", "write_diagnosis"]
 
@@ -42,8 +42,10 @@ def _slug(text: str) -> str:
 
 def diagnosis_figures(diag) -> Iterator[tuple[str, Any]]:
     """``(file stem, Figure)`` of every channel, one at a time (a long recording's figures are drawn and
-    let go in turn): spectrum, orders, TSA per shaft, kurtogram, envelope."""
+    let go in turn): spectrum, orders, TSA per shaft, kurtogram, envelope; the spectra with the bearings'
+    defect frequencies marked (:mod:`gearbody.reports.bearings`)."""
     f_in = diag.mean_input_hz
+    bearings = _bearings(diag)
     for name, ch in diag.channels.items():
         tag = _slug(name)
         f_max = max((p.frequency_hz for p in ch.peaks), default=ch.spectrum.frequency_hz[-1]) * 1.05
@@ -55,6 +57,7 @@ def diagnosis_figures(diag) -> Iterator[tuple[str, Any]]:
                 f"spectrum of {name} [{ch.unit}], input shaft {f_in:.3f} rev/s",
                 ch.unit,
                 min(float(ch.spectrum.frequency_hz[-1]), f_max),
+                marks=bearings.marks(f_in, min(float(ch.spectrum.frequency_hz[-1]), f_max)),
             ),
         )
         if ch.order_spectrum is not None:
@@ -67,6 +70,7 @@ def diagnosis_figures(diag) -> Iterator[tuple[str, Any]]:
                     f"order spectrum of {name} [{ch.unit}]",
                     ch.unit,
                     max_order,
+                    marks=bearings.marks(1.0, max_order),
                 ),
             )
         if ch.rpm_order_map is not None:
@@ -92,8 +96,16 @@ def diagnosis_figures(diag) -> Iterator[tuple[str, Any]]:
                     f"squared-envelope spectrum of {name}{white} in the kurtogram's band",
                     "relative" if ch.prewhitened else f"({ch.unit})^2",
                     f_top,
+                    marks=bearings.marks(f_in, f_top),
                 ),
             )
+
+
+def _bearings(diag):
+    """The bearings' section of a diagnosis: Hz at its mean input speed."""
+    from .bearings import bearing_section
+
+    return bearing_section(diag.drive, {"at the recording's mean input speed": diag.mean_input_hz})
 
 
 def write_diagnosis(diag, out: str | Path, title: str = "") -> list[Path]:
@@ -130,6 +142,7 @@ def _page(diag, images: dict[str, str], title: str) -> str:
         f"({html.escape(diag.angles.source)}); mean input shaft speed {diag.mean_input_hz:.4f} rev/s "
         f"({60 * diag.mean_input_hz:.1f} rpm).</p>",
         *(f"<p><b>note:</b> {html.escape(n)}</p>" for n in diag.notes),
+        bearing_html(_bearings(diag)),
     ]
     for name, ch in diag.channels.items():
         tag = _slug(name)

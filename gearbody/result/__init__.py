@@ -286,19 +286,20 @@ class Result:
             vibration_signal=self.vibration_signal_name,
         )
 
-    def plot(self, out_dir: str | Path) -> list[Path]:
+    def plot(self, out_dir: str | Path, marks=()) -> list[Path]:
         """The run's standard PNGs in ``out_dir``: per parallel stage K_d over time and folded over the
-        mesh period, the spectrum of the vibration signal, bearing forces (gearbody.plotting.run); per
-        planetary stage its planet meshes' K_d, load sharing and ring-sensor spectrum
-        (gearbody.plotting.planetary)."""
+        mesh period, the spectrum of the vibration signal (``marks``, lines with ``frequency_hz`` and
+        ``label`` such as bearing defect frequencies, drawn on it), bearing forces
+        (gearbody.plotting.run); per planetary stage its planet meshes' K_d, load sharing and ring-sensor
+        spectrum (gearbody.plotting.planetary)."""
         from ..plotting.run import write_plots
 
         Path(out_dir).mkdir(parents=True, exist_ok=True)
-        paths = write_plots(self, out_dir)
+        paths = write_plots(self, out_dir, marks)
         if self.planetary_stages:
             from ..plotting.planetary import write_planetary_plots
 
-            paths += write_planetary_plots(self, out_dir)
+            paths += write_planetary_plots(self, out_dir, marks)
         return paths
 
     def _stage(self, stage: int) -> StageMeta:
