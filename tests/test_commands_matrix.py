@@ -74,7 +74,16 @@ def test_run_writes_result_summary_report_and_every_stages_plots(scene, tmp_path
     expected = expected_run_plots(scene)
     assert expected <= written, expected - written
     assert written - expected <= {"bearing_forces.png"}, written - expected
-    assert capsys.readouterr().err == ""
+    _no_error_but_notes(scene, capsys.readouterr().err)
+
+
+def _no_error_but_notes(scene: str, err: str) -> None:
+    """Nothing on stderr, but for a scene with instruments, notes on what a run this short cannot give
+    (a tacho of fewer than 3 pulses: the virtual recording has none)."""
+    if load_scenario(scene).instruments is None:
+        assert err == ""
+    else:
+        assert all(line.startswith("gearbody: note:") for line in err.splitlines()), err
 
 
 @pytest.mark.parametrize("scene", SCENES)
@@ -85,10 +94,11 @@ def test_analyze_and_compare_take_every_scenes_run(scene, tmp_path, capsys):
     assert main(["run", scene, "--t-end", T_END, "--out", str(run), "--quiet", "--no-plots"]) == 0
     assert main(["analyze", str(run), "--out", str(tmp_path / "a")]) == 0
     assert (tmp_path / "a" / "report.html").is_file() and (tmp_path / "a" / "features.json").is_file()
-    assert main(["compare", str(run), str(run), "--out", str(tmp_path / "c")]) == 0
+    # the run beside its own signals (result.npz; a folder with instruments.mat gives its instruments)
+    assert main(["compare", str(run), str(run / "result.npz"), "--out", str(tmp_path / "c")]) == 0
     rows = json.loads((tmp_path / "c" / "comparison.json").read_text())["features"]
     assert rows and all(r["ratio"] == 1.0 for r in rows if r["run"] != 0)
-    assert capsys.readouterr().err == ""
+    _no_error_but_notes(scene, capsys.readouterr().err)
 
 
 @pytest.mark.parametrize("scene", SCENES)

@@ -74,8 +74,12 @@ def test_the_table_is_read_anchored_to_the_scene_file_and_written_back(tmp_path,
     assert override.instruments.accelerometers[1].frf_file == str(tmp_path / "here.csv")  # typed: cwd
 
 
-def test_shipped_scenes_have_no_instruments():
-    assert all(load_scenario(s).instruments is None for s in list_scenes())
+def test_of_the_shipped_scenes_only_phm2009_has_instruments_its_published_acquisition():
+    assert [s for s in list_scenes() if load_scenario(s).instruments is not None] == ["phm2009"]
+    table = load_scenario("phm2009").instruments
+    assert table.sample_rate_hz == pytest.approx(200e3 / 3, rel=1e-15)
+    assert table.tacho.pulses_per_rev == 10 and table.tacho.shaft == "input"
+    assert [a.name for a in table.accelerometers] == ["acc_input", "acc_output"]
 
 
 @pytest.mark.parametrize(

@@ -24,7 +24,8 @@ COLUMNS = {
 """The table's first columns (then one column of Hz per speed)."""
 
 NOTE = (
-    "Rigid rolling without slip (real bearings slip by 1-2 %, so measured lines sit slightly below); "
+    "Rigid rolling without slip (real bearings slip by 1-2 %, so measured lines sit slightly below and "
+    "smear; a 'rolling-elements' bearing's seeded cage slip smears them about these values); "
     "a rolling element's defect strikes both races once per spin: its impacts repeat at 2 BSF. Marked on "
     "the spectra where in range (dotted): BPFO, BPFI, 2 BSF and FTF of each bearing."
 )
