@@ -120,12 +120,23 @@ def mesh_geometry(mesh: dict) -> dict:
     return {"n": n, "e": e, "e_perp": e_perp, "s1": s1, "m": m}
 
 
-def bearing_force(bearing: dict, u, u_dot) -> np.ndarray:
-    """Literal bearing law f_b = law.force_N(u, u') (u, u' in the housing frame, 2-vectors)."""
+_ROLLING: dict[int, object] = {}  # id of a rolling-elements table -> its RollingBearing (made once)
+
+
+def bearing_force(bearing: dict, u, u_dot, inner: float = 0.0, outer: float = 0.0) -> np.ndarray:
+    """Literal bearing law f_b = law.force_N(u, u') (u, u' in the law's frame, 2-vectors; ``inner`` and
+    ``outer`` the races' angles there, read by the rolling-elements law only)."""
     kind = bearing["kind"]
     par = bearing["parameters"]
     x, y = float(u[0]), float(u[1])
     vx, vy = float(u_dot[0]), float(u_dot[1])
+    if kind == "rolling-elements":
+        from .rolling_bearing import RollingBearing
+
+        law = _ROLLING.get(id(bearing))
+        if law is None or law.table is not bearing:
+            law = _ROLLING[id(bearing)] = RollingBearing(bearing)
+        return np.array(law.force(x, y, vx, vy, float(inner), float(outer)))
     if kind == "linear":
         return -np.array(
             [

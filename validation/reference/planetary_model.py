@@ -388,8 +388,8 @@ class PlanetaryStage:
         cf = 1.0 if damping else 0.0
         for m in range(3):  # central members on isotropic spring-dampers (or their law) to the ground
             if self.law[m] is not None:
-                Q[3 * m : 3 * m + 2] += bearing_force(
-                    self.law[m], q[3 * m : 3 * m + 2], cf * v[3 * m : 3 * m + 2]
+                Q[3 * m : 3 * m + 2] += bearing_force(  # the member turns the inner race
+                    self.law[m], q[3 * m : 3 * m + 2], cf * v[3 * m : 3 * m + 2], q[3 * m + 2]
                 )
                 continue
             Q[3 * m : 3 * m + 2] -= self.kb[m] * q[3 * m : 3 * m + 2] + cf * self.cb[m] * v[3 * m : 3 * m + 2]
@@ -413,6 +413,8 @@ class PlanetaryStage:
                     self.law[3],
                     (ca * ex + sa * ey, -sa * ex + ca * ey),
                     (cf * (ca * dx + sa * dy), cf * (-sa * dx + ca * dy)),
+                    0.0,  # the pin is the inner race; the planet turns the outer relative to the carrier
+                    q[b + 2] - tc,
                 )
                 fx, fy = ca * fr - sa * ft, sa * fr + ca * ft
             Q[b] += fx

@@ -28,6 +28,7 @@ class RollingBearing:
     defects); :meth:`force` on floats (outer race fixed), :meth:`forces` on arrays."""
 
     def __init__(self, bearing: dict):
+        self.table = bearing
         par, geo = bearing["parameters"], bearing["geometry"]
         self.K = float(par["ball_stiffness_N_per_m_n"])
         self.c = float(par.get("radial_clearance_m", 0.0))
@@ -61,16 +62,16 @@ class RollingBearing:
                 (race, centre, half, float(df["depth_m"]), int(df.get("ball", 0)), radius[race])
             )
 
-    def cage(self, theta: float) -> float:
-        """Cage angle with the inner race turned by theta (outer fixed)."""
-        kin = self.rc * theta
+    def cage(self, theta: float, outer: float = 0.0) -> float:
+        """Cage angle with the inner race turned by theta and the outer by ``outer``."""
+        kin = self.rc * (theta - outer)
         if self.starts is None:
-            return kin
+            return outer + kin
         m = len(self.starts) - 1
         whole, rest = divmod(kin, self.pitch * m)  # whole tables of spacings, and the remainder
         k = min(int(rest // self.pitch), m - 1)
         frac = (rest - k * self.pitch) / self.pitch
-        return whole * self.starts[m] + self.starts[k] + frac * (self.starts[k + 1] - self.starts[k])
+        return outer + whole * self.starts[m] + self.starts[k] + frac * (self.starts[k + 1] - self.starts[k])
 
     @staticmethod
     def _sag(inside: float, depth: float, rho: float) -> float:
@@ -78,34 +79,36 @@ class RollingBearing:
             return 0.0
         return min(depth, rho if inside >= rho else rho - math.sqrt(rho * rho - inside * inside))
 
-    def drop(self, j: int, phi: float, theta: float) -> float:
-        """How far ball j at angle phi falls into the defects (inner race at theta)."""
+    def drop(self, j: int, phi: float, theta: float, outer: float = 0.0) -> float:
+        """How far ball j at angle phi falls into the defects (inner race at theta, outer at ``outer``)."""
         h = 0.0
         for race, centre, half, depth, ball, radius in self.defects:
             if race == "outer":
-                off = math.remainder(phi - centre, TWO_PI)
+                off = math.remainder(phi - outer - centre, TWO_PI)
                 h += self._sag(half - abs(off) * radius, depth, self.rho["outer"])
             elif race == "inner":
                 off = math.remainder(phi - theta - centre, TWO_PI)
                 h += self._sag(half - abs(off) * radius, depth, self.rho["inner"])
             elif ball == j:
-                psi = centre + self.spin * theta
+                psi = centre + self.spin * (theta - outer)
                 h += self._sag(half - abs(math.remainder(psi, TWO_PI)) * radius, depth, self.rho["outer"])
                 h += self._sag(
                     half - abs(math.remainder(psi - math.pi, TWO_PI)) * radius, depth, self.rho["inner"]
                 )
         return h
 
-    def force(self, x: float, y: float, vx: float, vy: float, theta: float) -> tuple[float, float]:
-        """Force on the journal (N)."""
+    def force(
+        self, x: float, y: float, vx: float, vy: float, theta: float, outer: float = 0.0
+    ) -> tuple[float, float]:
+        """Force on the journal (N), the inner race turned by theta and the outer by ``outer``."""
         fx, fy = -self.C * vx, -self.C * vy
-        base = self.cage(theta)
+        base = self.cage(theta, outer)
         for j in range(self.Z):
             phi = base + j * self.pitch
             cx, cy = math.cos(phi), math.sin(phi)
             defl = x * cx + y * cy - self.c
             if defl > 0.0 and self.defects:
-                defl -= self.drop(j, phi, theta)
+                defl -= self.drop(j, phi, theta, outer)
             if defl > 0.0:
                 p = self.K * defl**self.n
                 fx -= p * cx
