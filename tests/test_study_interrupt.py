@@ -700,3 +700,28 @@ def test_a_worker_stopped_by_sigterm_has_its_job_run_again(tmp_path):
     outcomes = dict(executors.run_pool(_term_once, jobs, workers=2))
     assert sorted(outcomes) == ["a", "b"] and all(o["ok"] for o in outcomes.values())
     assert (tmp_path / "a").exists()  # its first attempt was stopped
+
+
+def test_a_ctrl_c_inside_a_compiled_call_interrupts_the_case_instead_of_failing_it(monkeypatch):
+    """A KeyboardInterrupt that lands inside a numba call surfaces as a SystemError with the interrupt as
+    its context (seen in a loaded CI run): run_case raises it as the interrupt it is."""
+    from gearbody.studies import tasks
+
+    def interrupted_in_numba(*args, **kwargs):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            raise SystemError("CPUDispatcher(...) returned a result with an exception set") from None
+
+    def plain_failure(*args, **kwargs):
+        raise SystemError("a genuine failure")
+
+    import gearbody.engine
+    import gearbody.model
+
+    monkeypatch.setattr(gearbody.model, "load_scenario", lambda *args: None)
+    monkeypatch.setattr(gearbody.engine, "simulate", interrupted_in_numba)
+    with pytest.raises(KeyboardInterrupt):
+        tasks.run_case({}, [])
+    monkeypatch.setattr(gearbody.engine, "simulate", plain_failure)
+    assert tasks.run_case({}, [])["ok"] is False

@@ -39,7 +39,20 @@ def run_case(base: Mapping[str, Any], overrides: Sequence[str], keep_result: boo
             "wall_time_s": wall,
         }
     except Exception as exc:  # any failure is recorded for this case; the study goes on
+        raise_if_interrupted(exc)
         return failure(exc, time.perf_counter() - t0)
+
+
+def raise_if_interrupted(exc: BaseException) -> None:
+    """Raise KeyboardInterrupt when ``exc`` is a Ctrl-C in disguise: one that landed inside a compiled
+    (numba) call surfaces as a SystemError whose context is the KeyboardInterrupt. A case interrupted so
+    is not a failed case: the study stops and resumes it."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            raise KeyboardInterrupt from None
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
 
 
 SPEED_VALUES = (
@@ -82,4 +95,5 @@ def speed_case(base: Mapping[str, Any], overrides: Sequence[str], settle_s: floa
             "wall_time_s": time.perf_counter() - t0,
         }
     except Exception as exc:  # a failed speed is reported, the sweep goes on
+        raise_if_interrupted(exc)
         return failure(exc, time.perf_counter() - t0)
