@@ -101,14 +101,7 @@ class MeasuredFRF:
         """The accelerance of ``modes`` (:class:`~gearbody.recording.instruments.HousingMode`) sampled at
         ``frequency_hz``: sum_m phi_(m,b) s^2 / (s^2 + 2 zeta_m w_m s + w_m^2), s = i 2 pi f."""
         f = np.asarray(frequency_hz, dtype=float)
-        s = 2j * np.pi * f
-        out: dict[str, np.ndarray] = {}
-        for mode in modes:
-            w, z = 2 * math.pi * mode.frequency_hz, mode.damping_ratio
-            shape = s**2 / (s**2 + 2 * z * w * s + w**2)
-            for name, phi in mode.participation.items():
-                out[name] = out.get(name, 0) + phi * shape
-        return cls(f, out, source)
+        return cls(f, modal_accelerance(modes, 2j * np.pi * f), source)
 
     def kernels(self, sample_rate_hz: float) -> tuple[dict[str, np.ndarray], int]:
         """({force signal: windowed impulse response [(m/s^2)/N per sample], starting P samples before t =
@@ -188,14 +181,20 @@ def modal_kernels(modes, sample_rate_hz: float) -> tuple[dict[str, np.ndarray], 
             f"{decay_s:.3g} s, longer than {_MAX_GRID} samples at {fs:g} Hz; give it more damping"
         )
     n = 1 << max(8, math.ceil(math.log2(needed)))
-    s = 2j * np.pi * np.arange(n // 2 + 1) * fs / n
-    values: dict[str, np.ndarray] = {}
+    values = modal_accelerance(modes, 2j * np.pi * np.arange(n // 2 + 1) * fs / n)
+    return impulse_responses(values, n, pre, fs, "housing modes"), pre
+
+
+def modal_accelerance(modes, s: np.ndarray) -> dict[str, np.ndarray]:
+    """{force signal: sum_m phi_(m,b) s^2 / (s^2 + 2 zeta_m w_m s + w_m^2)} of ``modes`` (HousingMode)
+    at the Laplace points ``s`` (i 2 pi f)."""
+    out: dict[str, np.ndarray] = {}
     for mode in modes:
         w, z = 2 * math.pi * mode.frequency_hz, mode.damping_ratio
         shape = s**2 / (s**2 + 2 * z * w * s + w**2)
         for name, phi in mode.participation.items():
-            values[name] = values.get(name, 0) + phi * shape
-    return impulse_responses(values, n, pre, fs, "housing modes"), pre
+            out[name] = out.get(name, 0) + phi * shape
+    return out
 
 
 def impulse_responses(values: Mapping[str, np.ndarray], n: int, pre: int, fs: float, label: str):
